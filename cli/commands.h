@@ -1,0 +1,30 @@
+#pragma once
+
+// Subcommands of the shapedb executable. Each is thin: it parses, calls the library, and prints.
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace shapedb::cli {
+
+/// Exit codes shared by every subcommand.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitInputError = 1,  ///< the input was bad: a one-line message on stderr says why
+  kExitUsage = 2,       ///< the command line was bad
+  kExitInternal = 3,    ///< a bug: an unexpected exception reached main
+};
+
+/// A registered subcommand: its CLI11 node and what to run when it is chosen.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command addInspectCommand(CLI::App& parent);
+
+/// Prints "shapedb: <message>" on stderr, one line.
+void printError(const std::string& message);
+
+}  // namespace shapedb::cli

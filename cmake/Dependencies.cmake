@@ -1,0 +1,30 @@
+# Every third-party library comes from Debian 12's packages (see scripts/setup.sh).
+list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)  # Debian ships FindOpenVDB.cmake only
+
+find_package(TBB CONFIG REQUIRED)
+find_package(OpenVDB REQUIRED)
+find_package(Eigen3 3.4 CONFIG REQUIRED)
+find_package(Spectra CONFIG REQUIRED)
+find_package(OpenMesh CONFIG REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(nlohmann_json 3.11 CONFIG REQUIRED)
+find_package(SQLite3 REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
+
+find_path(TETGEN_INCLUDE_DIR tetgen.h REQUIRED)
+find_library(TETGEN_LIBRARY NAMES tet REQUIRED)
+if(NOT TARGET TetGen::tet)
+  add_library(TetGen::tet UNKNOWN IMPORTED)
+  set_target_properties(TetGen::tet PROPERTIES
+    IMPORTED_LOCATION "${TETGEN_LIBRARY}"
+    INTERFACE_INCLUDE_DIRECTORIES "${TETGEN_INCLUDE_DIR}"
+    INTERFACE_COMPILE_DEFINITIONS TETLIBRARY)
+endif()
+
+if(SHAPEDB_BUILD_TESTS)
+  find_package(GTest CONFIG REQUIRED)
+endif()
+if(SHAPEDB_BUILD_BENCH)
+  find_package(benchmark CONFIG REQUIRED)
+endif()

@@ -1,0 +1,18 @@
+# shapedb_warnings: the warning set for shapedb's own code (third-party headers come in as -isystem).
+add_library(shapedb_warnings INTERFACE)
+target_compile_options(shapedb_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast -Wcast-align
+  -Woverloaded-virtual -Wnull-dereference -Wimplicit-fallthrough
+  $<$<BOOL:${SHAPEDB_WERROR}>:-Werror>)
+
+# shapedb_add_module(name SOURCES ... DEPENDS ...): one library per top-level folder, shapedb::<name>.
+function(shapedb_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPENDS;PRIVATE_DEPENDS" ${ARGN})
+  add_library(shapedb_${name} STATIC ${ARG_SOURCES})
+  add_library(shapedb::${name} ALIAS shapedb_${name})
+  target_include_directories(shapedb_${name} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
+  target_link_libraries(shapedb_${name} PUBLIC ${ARG_PUBLIC_DEPENDS} PRIVATE ${ARG_PRIVATE_DEPENDS}
+    $<BUILD_INTERFACE:shapedb_warnings>)
+  set_target_properties(shapedb_${name} PROPERTIES OUTPUT_NAME shapedb_${name} POSITION_INDEPENDENT_CODE ON)
+endfunction()

@@ -1,0 +1,29 @@
+#pragma once
+
+#include <shapedb/core/triangle_mesh.h>
+#include <shapedb/core/types.h>
+
+namespace shapedb::core {
+
+/// Closed, outward-oriented triangle meshes of simple solids, centred at the origin unless stated.
+/// The building blocks of the shape families and of analytic tests. Sizes in metres.
+
+/// The tetrahedron (a, b, c, d), wound outward whatever the order of the points.
+/// Precondition: the points are not coplanar.
+TriangleMesh makeTetrahedron(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// Box of side lengths size.x() × size.y() × size.z(), 12 triangles.
+TriangleMesh makeBox(const Vec3& size);
+
+/// Ellipsoid with semi-axes `radii` as a latitude-longitude mesh: `slices` ≥ 3 around z, `stacks` ≥ 2
+/// from pole to pole. radii = (r, r, r) gives a sphere.
+TriangleMesh makeUvEllipsoid(const Vec3& radii, int slices, int stacks);
+
+/// Sphere of the given radius from an icosahedron subdivided `subdivisions` times, vertices projected
+/// to the sphere: 20·4^subdivisions near-uniform triangles.
+TriangleMesh makeIcosphere(double radius, int subdivisions);
+
+/// Circular cylinder along z, `segments` ≥ 3 around, capped by triangle fans about the cap centres.
+TriangleMesh makeCylinder(double radius, double height, int segments);
+
+}  // namespace shapedb::core

@@ -1,0 +1,65 @@
+#pragma once
+
+#include <cstddef>
+
+#include <shapedb/core/result.h>
+#include <shapedb/core/triangle_mesh.h>
+
+namespace shapedb::core {
+
+/// What a mesh's connectivity says about it, computed by analyzeTopology. Plain value type.
+struct TopologyReport {
+  std::size_t vertexCount = 0;  ///< vertices referenced by at least one triangle
+  std::size_t unreferencedVertices = 0;
+  std::size_t triangleCount = 0;
+  std::size_t edgeCount = 0;          ///< undirected edges
+  std::size_t boundaryEdges = 0;      ///< edges with exactly one triangle
+  std::size_t nonManifoldEdges = 0;   ///< edges with three or more triangles
+  std::size_t inconsistentEdges = 0;  ///< two-triangle edges traversed twice in the same direction
+  std::size_t components = 0;         ///< connected components (triangles sharing a vertex)
+
+  /// Every edge has exactly two triangles: the surface can enclose a volume.
+  bool isClosed() const { return boundaryEdges == 0 && nonManifoldEdges == 0; }
+  /// Every two-triangle edge is traversed once in each direction.
+  bool isConsistentlyOriented() const { return inconsistentEdges == 0; }
+  /// V - E + F over referenced vertices (2 per sphere-like closed component).
+  long eulerCharacteristic() const {
+    return static_cast<long>(vertexCount) - static_cast<long>(edgeCount) + static_cast<long>(triangleCount);
+  }
+};
+
+/// Counts boundary, non-manifold and inconsistently oriented edges and connected components.
+/// Precondition: every index is in range (validateMesh). O(F log F); thread-safe (pure function).
+TopologyReport analyzeTopology(const TriangleMesh& mesh);
+
+/// The error a mass-property computation should report for this topology, or Ok when the surface is
+/// closed and consistently oriented: "mesh is not closed (14 boundary edges)".
+Status requireClosedOriented(const TopologyReport& topology);
+
+/// What validateMesh tolerates.
+struct ValidationOptions {
+  /// Keep going past degenerate faces (repeated vertex or zero area); they are still counted.
+  bool allowDegenerateFaces = false;
+};
+
+/// Per-mesh counts of the defects validateMesh looks for.
+struct MeshDefects {
+  std::size_t nonFiniteVertices = 0;
+  std::size_t outOfRangeIndices = 0;
+  std::size_t repeatedVertexFaces = 0;  ///< faces such as (a, a, b)
+  std::size_t zeroAreaFaces = 0;        ///< distinct vertices, but collinear or coincident
+};
+
+/// Counts the defects of a mesh. Never fails; out-of-range faces are skipped by the area test.
+MeshDefects findDefects(const TriangleMesh& mesh);
+
+/// Checks that a mesh can be processed: vertices and faces present, all coordinates finite, all
+/// indices in range, no degenerate face (unless allowed). The error names the first offender:
+/// "face 7 refers to vertex 120, but the mesh has 100 vertices".
+Status validateMesh(const TriangleMesh& mesh, const ValidationOptions& options = {});
+
+/// Removes faces with a repeated vertex index (they have no area and no proper edges) and returns how
+/// many were removed. Zero-area faces with distinct vertices stay: they may close a T-junction.
+std::size_t removeRepeatedVertexFaces(TriangleMesh& mesh);
+
+}  // namespace shapedb::core

@@ -1,0 +1,140 @@
+#include <cmath>
+#include <string>
+
+#include <shapedb/core/mass_properties.h>
+
+namespace shapedb::core {
+namespace {
+
+// Volume integrals of 1, p and p pᵀ over the solid (unit density), relative to a reference point.
+struct VolumeIntegrals {
+  double volume = 0.0;          // ∫ 1 dV
+  double absoluteVolume = 0.0;  // Σ |tet volume|: the scale against which a near-zero volume is judged
+  Vec3 first = Vec3::Zero();    // ∫ p dV
+  Mat3 second = Mat3::Zero();   // ∫ p pᵀ dV
+  double area = 0.0;
+};
+
+// Sum over the fan of tetrahedra (r, a, b, c), one per triangle; closed surfaces make it exact for any r.
+// For a tet with one vertex at the origin and det d = a·(b×c): V = d/6, ∫p = d/24 (a+b+c),
+// ∫p pᵀ = d/120 (a aᵀ + b bᵀ + c cᵀ + s sᵀ), s = a+b+c (Tonon 2004, the covariance of a simplex).
+VolumeIntegrals integrateFan(const TriangleMesh& mesh, const Vec3& reference) {
+  double sumDet = 0.0, sumAbsDet = 0.0, twiceArea = 0.0;
+  Vec3 sumFirst = Vec3::Zero();
+  Mat3 sumSecond = Mat3::Zero();
+  for (const auto& t : mesh.triangles) {
+    const Vec3 a = mesh.vertices[t[0]] - reference;
+    const Vec3 b = mesh.vertices[t[1]] - reference;
+    const Vec3 c = mesh.vertices[t[2]] - reference;
+    const Vec3 n = (b - a).cross(c - a);
+    const double d = a.dot(b.cross(c));
+    const Vec3 s = a + b + c;
+    twiceArea += n.norm();
+    sumDet += d;
+    sumAbsDet += std::abs(d);
+    sumFirst += d * s;
+    sumSecond.noalias() +=
+        d * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+  }
+  VolumeIntegrals out;
+  out.volume = sumDet / 6.0;
+  out.absoluteVolume = sumAbsDet / 6.0;
+  out.first = sumFirst / 24.0;
+  out.second = sumSecond / 120.0;
+  out.area = 0.5 * twiceArea;
+  return out;
+}
+
+// The paper's approximation for surfaces that enclose no well-defined volume (§4.1): the mass spread
+// over the vertices, each weighted by a third of its triangles' area; the volume estimated by the fan
+// from the area-weighted centroid, which is exact when the surface is in fact closed.
+Result<MassProperties> approximateFromVertices(const TriangleMesh& mesh, double density) {
+  std::vector<double> weight(mesh.vertices.size(), 0.0);
+  double totalWeight = 0.0;
+  for (const auto& t : mesh.triangles) {
+    const double third =
+        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm() /
+        6.0;
+    for (std::uint32_t v : t)
+      weight[v] += third;
+    totalWeight += 3.0 * third;
+  }
+  if (!(totalWeight > 0.0)) return Error{ErrorCode::kZeroVolume, "mesh has zero surface area"};
+
+  Vec3 centroid = Vec3::Zero();
+  for (std::size_t v = 0; v < weight.size(); ++v)
+    centroid += weight[v] * mesh.vertices[v];
+  centroid /= totalWeight;
+
+  const VolumeIntegrals fan = integrateFan(mesh, centroid);
+  const double volume = std::abs(fan.volume);
+  if (!(volume > 1e-9 * std::pow(fan.area, 1.5)))
+    return Error{ErrorCode::kZeroVolume, "cannot estimate a volume from this open surface"};
+
+  // Point-mass covariance scaled so that the total mass is density · volume.
+  Mat3 covariance = Mat3::Zero();
+  for (std::size_t v = 0; v < weight.size(); ++v) {
+    const Vec3 r = mesh.vertices[v] - centroid;
+    covariance.noalias() += weight[v] * r * r.transpose();
+  }
+  MassProperties out;
+  out.density = density;
+  out.volume = volume;
+  out.mass = density * volume;
+  out.area = fan.area;
+  out.centerOfMass = centroid;
+  out.inertia = inertiaFromCovariance(covariance * (out.mass / totalWeight));
+  out.isApproximate = true;
+  return out;
+}
+
+}  // namespace
+
+Result<MassProperties> computeMassProperties(const TriangleMesh& mesh, const TopologyReport& topology,
+                                             const MassPropertiesOptions& options) {
+  if (!(std::isfinite(options.density) && options.density > 0.0))
+    return Error{ErrorCode::kInvalidArgument, "density must be finite and positive"};
+  if (mesh.triangles.empty()) return Error{ErrorCode::kEmptyMesh, "mesh has no faces"};
+
+  // Surfaces that bound no well-defined solid: an error, or the approximation when asked for.
+  if (Status closed = requireClosedOriented(topology); !closed) {
+    if (!options.allowApproximate) return closed.error();
+    return approximateFromVertices(mesh, options.density);
+  }
+
+  // Integrate relative to a vertex of the mesh, so that a mesh far from the origin keeps its precision.
+  const Vec3 reference = mesh.vertices[mesh.triangles.front()[0]];
+  VolumeIntegrals fan = integrateFan(mesh, reference);
+
+  if (!(std::abs(fan.volume) > 1e-12 * fan.absoluteVolume) || !(fan.absoluteVolume > 0.0))
+    return Error{ErrorCode::kZeroVolume, "mesh encloses no volume"};
+  MassProperties out;
+  if (fan.volume < 0.0) {
+    if (!options.flipInsideOut) {
+      return Error{ErrorCode::kInsideOut,
+                   "mesh is inside out (signed volume " + std::to_string(fan.volume) + " m³)"};
+    }
+    // Reversing every face negates every integral.
+    fan.volume = -fan.volume;
+    fan.first = -fan.first;
+    fan.second = -fan.second;
+    out.wasFlipped = true;
+  }
+
+  // Centre of mass, then the covariance moved to it (parallel-axis theorem).
+  const Vec3 comFromReference = fan.first / fan.volume;
+  const Mat3 covariance = fan.second - fan.volume * comFromReference * comFromReference.transpose();
+  out.density = options.density;
+  out.volume = fan.volume;
+  out.mass = options.density * fan.volume;
+  out.area = fan.area;
+  out.centerOfMass = reference + comFromReference;
+  out.inertia = inertiaFromCovariance(options.density * covariance);
+  return out;
+}
+
+Result<MassProperties> computeMassProperties(const TriangleMesh& mesh, const MassPropertiesOptions& options) {
+  return computeMassProperties(mesh, analyzeTopology(mesh), options);
+}
+
+}  // namespace shapedb::core

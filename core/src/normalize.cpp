@@ -1,0 +1,126 @@
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include <shapedb/core/normalize.h>
+
+namespace shapedb::core {
+namespace {
+
+// Third moments ∫(u·(p−c))³ dV along two axes, by the fan of tetrahedra from c. For a simplex with a
+// vertex at c and the others at wᵢ = u·(vᵢ − c): ∫(u·p)³ dV = V/20 · h₃(w₁, w₂, w₃), h₃ the complete
+// homogeneous symmetric polynomial of degree 3 (the Dirichlet integral over the simplex).
+std::array<double, 2> thirdMomentsExact(const TriangleMesh& mesh, const Vec3& c, const Vec3& ux,
+                                        const Vec3& uy) {
+  auto h3 = [](double w1, double w2, double w3) {
+    return w1 * w1 * (w1 + w2 + w3) + w2 * w2 * (w2 + w1 + w3) + w3 * w3 * (w3 + w1 + w2) + w1 * w2 * w3;
+  };
+  double sumX = 0.0, sumY = 0.0;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 a = mesh.vertices[t[0]] - c, b = mesh.vertices[t[1]] - c, d = mesh.vertices[t[2]] - c;
+    const double det = a.dot(b.cross(d));
+    sumX += det * h3(ux.dot(a), ux.dot(b), ux.dot(d));
+    sumY += det * h3(uy.dot(a), uy.dot(b), uy.dot(d));
+  }
+  // det/6 is the tet volume, and V/20 · h₃ = det/120 · h₃.
+  return {sumX / 120.0, sumY / 120.0};
+}
+
+// The same moments for the approximate (vertex point-mass) properties, weights a third of the area.
+std::array<double, 2> thirdMomentsOfVertices(const TriangleMesh& mesh, const MassProperties& mp,
+                                             const Vec3& ux, const Vec3& uy) {
+  double sumX = 0.0, sumY = 0.0, total = 0.0;
+  for (const auto& t : mesh.triangles) {
+    const double third =
+        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm() /
+        6.0;
+    for (std::uint32_t v : t) {
+      const Vec3 r = mesh.vertices[v] - mp.centerOfMass;
+      sumX += third * std::pow(ux.dot(r), 3);
+      sumY += third * std::pow(uy.dot(r), 3);
+    }
+    total += 3.0 * third;
+  }
+  // Scale to a volume integral, as the approximate inertia was.
+  const double toVolume = mp.volume / total;
+  return {sumX * toVolume, sumY * toVolume};
+}
+
+}  // namespace
+
+Result<Normalization> normalize(const TriangleMesh& mesh, const MassProperties& massProperties,
+                                const NormalizeOptions& options) {
+  const MassProperties& mp = massProperties;
+  if (!(std::isfinite(mp.volume) && mp.volume > 0.0 && mp.density > 0.0 && mp.centerOfMass.allFinite() &&
+        mp.inertia.allFinite()))
+    return Error{ErrorCode::kInvalidArgument, "mass properties are not finite and positive"};
+
+  // Principal moments and axes, ascending; x the axis of the smallest moment.
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen(mp.inertia);
+  if (eigen.info() != Eigen::Success)
+    return Error{ErrorCode::kInvalidArgument, "inertia tensor has no eigen-decomposition"};
+  Normalization out;
+  out.isApproximate = mp.isApproximate;
+  out.principalMoments = eigen.eigenvalues();
+  Vec3 x = eigen.eigenvectors().col(0);
+  Vec3 y = eigen.eigenvectors().col(1);
+
+  // Conditioning: relative gaps between consecutive moments.
+  const Vec3& m = out.principalMoments;
+  out.momentGaps = {(m[1] - m[0]) / m[2], (m[2] - m[1]) / m[2]};
+  const bool lowPair = out.momentGaps[0] < options.degeneracyTolerance;
+  const bool highPair = out.momentGaps[1] < options.degeneracyTolerance;
+  out.degeneracy = lowPair && highPair ? AxisDegeneracy::kAll
+                   : lowPair           ? AxisDegeneracy::kXY
+                   : highPair          ? AxisDegeneracy::kYZ
+                                       : AxisDegeneracy::kNone;
+
+  // Sign rule: positive third moment along x and y; skewness says how reliable that is.
+  const std::array<double, 2> m3 = mp.isApproximate ? thirdMomentsOfVertices(mesh, mp, x, y)
+                                                    : thirdMomentsExact(mesh, mp.centerOfMass, x, y);
+  // Second moments along x and y (unit density): σ² V = ∫(u·r)² dV = (tr(I) / 2 − λ) / ρ.
+  const double halfTrace = 0.5 * m.sum();
+  const std::array<double, 2> m2 = {(halfTrace - m[0]) / mp.density, (halfTrace - m[1]) / mp.density};
+  Vec3* axes[2] = {&x, &y};
+  for (int i = 0; i < 2; ++i) {
+    const double sigma = std::sqrt(std::max(m2[i], 0.0) / mp.volume);
+    const double skew = sigma > 0.0 ? m3[i] / (mp.volume * sigma * sigma * sigma) : 0.0;
+    if (skew < 0.0) *axes[i] = -*axes[i];
+    out.skewness[i] = std::abs(skew);
+    out.signAmbiguous[i] = out.skewness[i] < options.signTolerance;
+  }
+  const Vec3 z = x.cross(y);
+  out.principalAxes.col(0) = x;
+  out.principalAxes.col(1) = y;
+  out.principalAxes.col(2) = z;
+
+  // T = canonicalFromMesh: p' = s Rᵀ (p − c); T⁻¹: p = R p' / s + c.
+  out.scale = std::cbrt(1.0 / mp.volume);
+  const Mat3 rotation = out.principalAxes.transpose();
+  out.canonicalFromMesh.setIdentity();
+  out.canonicalFromMesh.topLeftCorner<3, 3>() = out.scale * rotation;
+  out.canonicalFromMesh.topRightCorner<3, 1>() = -out.scale * (rotation * mp.centerOfMass);
+  out.meshFromCanonical.setIdentity();
+  out.meshFromCanonical.topLeftCorner<3, 3>() = out.principalAxes / out.scale;
+  out.meshFromCanonical.topRightCorner<3, 1>() = mp.centerOfMass;
+
+  // Moments of the unit-volume, unit-density shape: inertia scales with ρ L⁵.
+  out.canonicalMoments = m * std::pow(out.scale, 5) / mp.density;
+  return out;
+}
+
+const char* toString(AxisDegeneracy degeneracy) {
+  switch (degeneracy) {
+    case AxisDegeneracy::kNone:
+      return "none";
+    case AxisDegeneracy::kXY:
+      return "xy";
+    case AxisDegeneracy::kYZ:
+      return "yz";
+    case AxisDegeneracy::kAll:
+      return "all";
+  }
+  return "unknown";
+}
+
+}  // namespace shapedb::core

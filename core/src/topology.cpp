@@ -1,0 +1,178 @@
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <shapedb/core/topology.h>
+
+namespace shapedb::core {
+namespace {
+
+// Disjoint sets over vertex indices, with path halving and union by size.
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : mParent(n), mSize(n, 1) {
+    std::iota(mParent.begin(), mParent.end(), 0u);
+  }
+  std::uint32_t find(std::uint32_t x) {
+    while (mParent[x] != x)
+      x = mParent[x] = mParent[mParent[x]];
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = find(a), b = find(b);
+    if (a == b) return;
+    if (mSize[a] < mSize[b]) std::swap(a, b);
+    mParent[b] = a;
+    mSize[a] += mSize[b];
+  }
+
+ private:
+  std::vector<std::uint32_t> mParent;
+  std::vector<std::uint32_t> mSize;
+};
+
+bool hasRepeatedVertex(const TriangleMesh::Triangle& t) {
+  return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
+}
+
+// Zero area relative to the triangle's own size: twice the area below 1e-12 of its longest edge squared.
+bool hasZeroArea(const TriangleMesh& mesh, const TriangleMesh::Triangle& t) {
+  const Vec3& a = mesh.vertices[t[0]];
+  const Vec3& b = mesh.vertices[t[1]];
+  const Vec3& c = mesh.vertices[t[2]];
+  const double longestSq = std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+  return (b - a).cross(c - a).norm() <= 1e-12 * longestSq;
+}
+
+std::string plural(std::size_t n, const std::string& noun, const std::string& nouns = "") {
+  return std::to_string(n) + " " + (n == 1 ? noun : nouns.empty() ? noun + "s" : nouns);
+}
+
+}  // namespace
+
+TopologyReport analyzeTopology(const TriangleMesh& mesh) {
+  TopologyReport report;
+  report.triangleCount = mesh.triangles.size();
+
+  // Each half-edge as (undirected key, direction); sorting groups the half-edges of an edge together.
+  struct HalfEdge {
+    std::uint64_t key;
+    bool forward;
+  };
+  std::vector<HalfEdge> halfEdges;
+  halfEdges.reserve(3 * mesh.triangles.size());
+  DisjointSets sets(mesh.vertices.size());
+  std::vector<char> referenced(mesh.vertices.size(), 0);
+  for (const auto& t : mesh.triangles) {
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+      referenced[a] = 1;
+      if (a == b) continue;
+      halfEdges.push_back({(std::uint64_t{std::min(a, b)} << 32) | std::max(a, b), a < b});
+      sets.unite(a, b);
+    }
+  }
+  std::sort(halfEdges.begin(), halfEdges.end(),
+            [](const HalfEdge& l, const HalfEdge& r) { return l.key < r.key; });
+
+  // Classify each edge by how many half-edges share it, and in which directions.
+  for (std::size_t begin = 0; begin < halfEdges.size();) {
+    std::size_t end = begin + 1;
+    while (end < halfEdges.size() && halfEdges[end].key == halfEdges[begin].key)
+      ++end;
+    const std::size_t count = end - begin;
+    ++report.edgeCount;
+    if (count == 1) ++report.boundaryEdges;
+    if (count > 2) ++report.nonManifoldEdges;
+    if (count == 2 && halfEdges[begin].forward == halfEdges[begin + 1].forward) ++report.inconsistentEdges;
+    begin = end;
+  }
+
+  // Components are the distinct roots among referenced vertices.
+  std::vector<char> isRoot(mesh.vertices.size(), 0);
+  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (!referenced[v]) {
+      ++report.unreferencedVertices;
+      continue;
+    }
+    ++report.vertexCount;
+    const std::uint32_t root = sets.find(v);
+    if (!isRoot[root]) ++report.components;
+    isRoot[root] = 1;
+  }
+  return report;
+}
+
+Status requireClosedOriented(const TopologyReport& topology) {
+  if (topology.boundaryEdges > 0)
+    return Error{ErrorCode::kNotClosed,
+                 "mesh is not closed (" + plural(topology.boundaryEdges, "boundary edge") + ")"};
+  if (topology.nonManifoldEdges > 0)
+    return Error{ErrorCode::kNonManifold,
+                 "mesh is not manifold (" + plural(topology.nonManifoldEdges, "edge") + " with 3+ faces)"};
+  if (topology.inconsistentEdges > 0)
+    return Error{ErrorCode::kInconsistentOrientation, "mesh is not consistently oriented (" +
+                                                          plural(topology.inconsistentEdges, "edge") +
+                                                          " traversed twice in the same direction)"};
+  return Ok{};
+}
+
+MeshDefects findDefects(const TriangleMesh& mesh) {
+  MeshDefects defects;
+  for (const Vec3& p : mesh.vertices)
+    if (!p.allFinite()) ++defects.nonFiniteVertices;
+  for (const auto& t : mesh.triangles) {
+    const bool inRange =
+        t[0] < mesh.vertices.size() && t[1] < mesh.vertices.size() && t[2] < mesh.vertices.size();
+    if (!inRange) {
+      ++defects.outOfRangeIndices;
+    } else if (hasRepeatedVertex(t)) {
+      ++defects.repeatedVertexFaces;
+    } else if (hasZeroArea(mesh, t)) {
+      ++defects.zeroAreaFaces;
+    }
+  }
+  return defects;
+}
+
+Status validateMesh(const TriangleMesh& mesh, const ValidationOptions& options) {
+  if (mesh.triangles.empty()) return Error{ErrorCode::kEmptyMesh, "mesh has no faces"};
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (!mesh.vertices[v].allFinite())
+      return Error{ErrorCode::kNonFinite, "vertex " + std::to_string(v) + " has a non-finite coordinate"};
+  }
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    for (std::uint32_t index : mesh.triangles[f]) {
+      if (index >= mesh.vertices.size())
+        return Error{ErrorCode::kIndexOutOfRange, "face " + std::to_string(f) + " refers to vertex " +
+                                                      std::to_string(index) + ", but the mesh has " +
+                                                      plural(mesh.vertices.size(), "vertex", "vertices")};
+    }
+  }
+  if (options.allowDegenerateFaces) return Ok{};
+  // Degenerate faces: report the count and the first one, so the user can find it.
+  std::size_t count = 0, first = 0;
+  const char* why = "";
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const bool repeated = hasRepeatedVertex(mesh.triangles[f]);
+    if (!repeated && !hasZeroArea(mesh, mesh.triangles[f])) continue;
+    if (count++ == 0) {
+      first = f;
+      why = repeated ? "repeated vertex" : "zero area";
+    }
+  }
+  if (count > 0)
+    return Error{ErrorCode::kDegenerateFace, plural(count, "degenerate face") + " (first: face " +
+                                                 std::to_string(first) + ", " + why + ")"};
+  return Ok{};
+}
+
+std::size_t removeRepeatedVertexFaces(TriangleMesh& mesh) {
+  const std::size_t before = mesh.triangles.size();
+  std::erase_if(mesh.triangles, hasRepeatedVertex);
+  return before - mesh.triangles.size();
+}
+
+}  // namespace shapedb::core

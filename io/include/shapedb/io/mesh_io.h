@@ -1,0 +1,47 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <shapedb/core/result.h>
+#include <shapedb/core/topology.h>
+#include <shapedb/core/triangle_mesh.h>
+
+namespace shapedb::io {
+
+/// What loadMesh tolerates.
+struct LoadOptions {
+  /// Keep degenerate faces instead of failing: faces with a repeated vertex are dropped (and counted),
+  /// zero-area faces with distinct vertices are kept (they contribute nothing to areas or volumes).
+  bool allowDegenerateFaces = false;
+};
+
+/// A mesh read from a file, with what was learnt about it on the way in. Plain value type.
+struct LoadedMesh {
+  core::TriangleMesh mesh;
+  core::TopologyReport topology;         ///< of `mesh` as returned
+  core::MeshDefects defects;             ///< as read, before any face was dropped
+  std::string format;                    ///< "obj", "ply", "off" or "stl"
+  std::size_t polygonsTriangulated = 0;  ///< faces with more than three vertices, fan-triangulated
+  std::size_t facesDropped = 0;          ///< repeated-vertex faces dropped under allowDegenerateFaces
+};
+
+/// Reads an OBJ, PLY (ASCII or binary), OFF or STL (ASCII or binary) file through OpenMesh, chosen by
+/// extension (case-insensitive). Polygons are fan-triangulated; vertices are kept as the file has them
+/// (STL's duplicated corners are merged by OpenMesh's reader). Every error names the file:
+/// "part.stl: truncated binary STL (header says 12 triangles, file holds 3)". Errors: kIo, kUnknownFormat,
+/// kParse, kEmptyMesh, kNonFinite, kIndexOutOfRange, kDegenerateFace. Thread-safe.
+Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options = {});
+
+/// What saveMesh writes.
+struct SaveOptions {
+  bool binary = true;  ///< PLY only: binary little-endian (exact doubles) rather than ASCII
+};
+
+/// Writes an OBJ or PLY file through OpenMesh, chosen by extension. Coordinates are written as doubles
+/// (OBJ with 17 significant digits), so a mesh read back is the same mesh. Errors: kUnknownFormat,
+/// kIo, kInvalidArgument (a mesh that fails validateMesh). Thread-safe.
+Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& path,
+                const SaveOptions& options = {});
+
+}  // namespace shapedb::io

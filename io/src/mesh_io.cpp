@@ -1,0 +1,175 @@
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include <shapedb/io/mesh_io.h>
+
+#include "openmesh_adapters.h"
+
+namespace shapedb::io {
+namespace {
+
+// OpenMesh's readers keep per-reader state and log through global streams: one call at a time, silenced.
+std::mutex& openMeshMutex() {
+  static std::mutex mutex;
+  static std::once_flag silenced;
+  std::call_once(silenced, [] {
+    omlog().disable();
+    omout().disable();
+    omerr().disable();
+  });
+  return mutex;
+}
+
+std::string lowercaseExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+Error fileError(const std::filesystem::path& path, ErrorCode code, const std::string& message) {
+  return Error{code, path.string() + ": " + message};
+}
+
+// Binary STL is a header, a triangle count and 50 bytes per triangle. OpenMesh trusts the count, so a
+// truncated file or a lying count is caught here first. ASCII STL starts with "solid".
+Status checkStlFraming(const std::filesystem::path& path, std::uintmax_t fileSize) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<char, 84> header{};
+  in.read(header.data(), header.size());
+  const auto got = static_cast<std::size_t>(in.gcount());
+  std::string start(header.data(), std::min<std::size_t>(got, 80));
+  start.erase(0, start.find_first_not_of(" \t\r\n"));
+  if (got == header.size()) {
+    std::uint32_t claimed = 0;
+    std::memcpy(&claimed, header.data() + 80, sizeof claimed);  // little-endian on every target we build
+    if (84 + 50 * std::uintmax_t{claimed} == fileSize) return Ok{};
+    if (start.rfind("solid", 0) == 0) return Ok{};
+    return fileError(path, ErrorCode::kParse,
+                     "truncated or corrupt binary STL (header says " + std::to_string(claimed) +
+                         " triangles, file holds " + std::to_string((fileSize - 84) / 50) + ")");
+  }
+  if (start.rfind("solid", 0) == 0) return Ok{};
+  return fileError(path, ErrorCode::kParse, "not an STL file (too short for binary, no 'solid' for ASCII)");
+}
+
+// Polygons fan-triangulated; polygons with fewer than three corners counted.
+struct Triangulated {
+  core::TriangleMesh mesh;
+  std::size_t polygons = 0;
+  std::size_t tooFewCorners = 0;
+  std::size_t firstTooFew = 0;
+};
+
+Triangulated triangulate(detail::RawImporter&& raw) {
+  Triangulated out;
+  out.mesh.vertices = std::move(raw.vertices);
+  out.mesh.triangles.reserve(raw.polygons.size());
+  for (std::size_t f = 0; f < raw.polygons.size(); ++f) {
+    const auto& polygon = raw.polygons[f];
+    if (polygon.size() < 3) {
+      if (out.tooFewCorners++ == 0) out.firstTooFew = f;
+      continue;
+    }
+    if (polygon.size() > 3) ++out.polygons;
+    for (std::size_t i = 1; i + 1 < polygon.size(); ++i)
+      out.mesh.triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options) {
+  // Format by extension, then the file itself.
+  const std::string format = lowercaseExtension(path);
+  if (format != "obj" && format != "ply" && format != "off" && format != "stl")
+    return fileError(
+        path, ErrorCode::kUnknownFormat,
+        "unknown mesh format '" + path.extension().string() + "' (expected .obj, .ply, .off or .stl)");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    return fileError(path, ErrorCode::kIo,
+                     std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");
+  const std::uintmax_t fileSize = std::filesystem::file_size(path, ec);
+  if (ec || !std::ifstream(path, std::ios::binary))
+    return fileError(path, ErrorCode::kIo, "cannot read file");
+  if (fileSize == 0) return fileError(path, ErrorCode::kParse, "file is empty");
+  if (format == "stl") {
+    if (Status framing = checkStlFraming(path, fileSize); !framing) return framing.error();
+  }
+
+  // Parse through OpenMesh into the raw importer; no OpenMesh exception crosses this function.
+  detail::RawImporter raw;
+  bool parsed = false;
+  {
+    std::lock_guard lock(openMeshMutex());
+    try {
+      OpenMesh::IO::Options readOptions;
+      parsed = OpenMesh::IO::IOManager().read(path.string(), raw, readOptions);
+    } catch (const std::exception& e) {
+      return fileError(path, ErrorCode::kParse, std::string("parse error: ") + e.what());
+    } catch (...) {
+      return fileError(path, ErrorCode::kParse, "parse error");
+    }
+  }
+  if (!parsed) return fileError(path, ErrorCode::kParse, "could not parse as " + format);
+
+  // Triangulate, then validate what was read.
+  Triangulated tri = triangulate(std::move(raw));
+  if (tri.tooFewCorners > 0 && !options.allowDegenerateFaces)
+    return fileError(path, ErrorCode::kDegenerateFace,
+                     std::to_string(tri.tooFewCorners) + " faces with fewer than 3 vertices (first: face " +
+                         std::to_string(tri.firstTooFew) + ")");
+  LoadedMesh out;
+  out.mesh = std::move(tri.mesh);
+  out.format = format;
+  out.polygonsTriangulated = tri.polygons;
+  out.facesDropped = tri.tooFewCorners;
+  if (Status valid = core::validateMesh(out.mesh, {.allowDegenerateFaces = options.allowDegenerateFaces});
+      !valid)
+    return withContext(valid.error(), path.string());
+  out.defects = core::findDefects(out.mesh);
+  if (options.allowDegenerateFaces) {
+    out.facesDropped += core::removeRepeatedVertexFaces(out.mesh);
+    if (out.mesh.triangles.empty())
+      return fileError(path, ErrorCode::kEmptyMesh, "mesh has no faces once degenerate faces are dropped");
+  }
+  out.topology = core::analyzeTopology(out.mesh);
+  return out;
+}
+
+Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& path,
+                const SaveOptions& options) {
+  const std::string format = lowercaseExtension(path);
+  if (format != "obj" && format != "ply")
+    return fileError(path, ErrorCode::kUnknownFormat,
+                     "cannot write format '" + path.extension().string() + "' (expected .obj or .ply)");
+  if (Status valid = core::validateMesh(mesh, {.allowDegenerateFaces = true}); !valid)
+    return Error{ErrorCode::kInvalidArgument,
+                 path.string() + ": refusing to write: " + valid.error().message};
+
+  detail::TriangleMeshExporter exporter(mesh);
+  OpenMesh::IO::Options writeOptions;
+  if (format == "ply" && options.binary) writeOptions += OpenMesh::IO::Options::Binary;
+  bool written = false;
+  {
+    std::lock_guard lock(openMeshMutex());
+    try {
+      written = OpenMesh::IO::IOManager().write(path.string(), exporter, writeOptions, 17);
+    } catch (...) {
+      written = false;
+    }
+  }
+  if (!written) return fileError(path, ErrorCode::kIo, "cannot write file");
+  return Ok{};
+}
+
+}  // namespace shapedb::io

@@ -1,0 +1,109 @@
+#include <gtest/gtest.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/core/topology.h>
+
+namespace shapedb::core {
+namespace {
+
+TEST(Topology, ClosedBoxIsClosedOrientedSphere) {
+  const TopologyReport t = analyzeTopology(makeBox({1, 2, 3}));
+  EXPECT_EQ(t.vertexCount, 8u);
+  EXPECT_EQ(t.triangleCount, 12u);
+  EXPECT_EQ(t.edgeCount, 18u);
+  EXPECT_EQ(t.boundaryEdges, 0u);
+  EXPECT_EQ(t.nonManifoldEdges, 0u);
+  EXPECT_EQ(t.inconsistentEdges, 0u);
+  EXPECT_EQ(t.components, 1u);
+  EXPECT_EQ(t.eulerCharacteristic(), 2);
+  EXPECT_TRUE(t.isClosed());
+  EXPECT_TRUE(requireClosedOriented(t).ok());
+}
+
+TEST(Topology, MissingFaceLeavesThreeBoundaryEdges) {
+  TriangleMesh box = makeBox({1, 1, 1});
+  box.triangles.pop_back();
+  const TopologyReport t = analyzeTopology(box);
+  EXPECT_EQ(t.boundaryEdges, 3u);
+  EXPECT_FALSE(t.isClosed());
+  const Status s = requireClosedOriented(t);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().code, ErrorCode::kNotClosed);
+  EXPECT_EQ(s.error().message, "mesh is not closed (3 boundary edges)");
+}
+
+TEST(Topology, FlippedFaceMakesThreeInconsistentEdges) {
+  TriangleMesh box = makeBox({1, 1, 1});
+  std::swap(box.triangles[4][1], box.triangles[4][2]);
+  const TopologyReport t = analyzeTopology(box);
+  EXPECT_TRUE(t.isClosed());
+  EXPECT_EQ(t.inconsistentEdges, 3u);
+  EXPECT_EQ(requireClosedOriented(t).error().code, ErrorCode::kInconsistentOrientation);
+}
+
+TEST(Topology, FinOnAnEdgeIsNonManifold) {
+  TriangleMesh box = makeBox({1, 1, 1});
+  box.vertices.emplace_back(2.0, 2.0, 2.0);
+  const auto& t0 = box.triangles[0];
+  box.triangles.push_back({t0[0], t0[1], 8});
+  const TopologyReport t = analyzeTopology(box);
+  EXPECT_EQ(t.nonManifoldEdges, 1u);
+  EXPECT_EQ(t.boundaryEdges, 2u);
+  EXPECT_EQ(requireClosedOriented(t).error().code, ErrorCode::kNotClosed);
+}
+
+TEST(Topology, CountsComponentsAndUnreferencedVertices) {
+  TriangleMesh a = makeBox({1, 1, 1});
+  const TriangleMesh b = makeIcosphere(1.0, 1);
+  const auto offset = static_cast<std::uint32_t>(a.vertices.size());
+  a.vertices.insert(a.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (auto t : b.triangles)
+    a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  a.vertices.emplace_back(9.0, 9.0, 9.0);
+  const TopologyReport t = analyzeTopology(a);
+  EXPECT_EQ(t.components, 2u);
+  EXPECT_EQ(t.eulerCharacteristic(), 4);
+  EXPECT_EQ(t.unreferencedVertices, 1u);
+}
+
+TEST(Validate, AcceptsAGoodMesh) {
+  EXPECT_TRUE(validateMesh(makeIcosphere(1.0, 2)).ok());
+}
+
+TEST(Validate, RejectsEachDefectWithItsCode) {
+  TriangleMesh empty;
+  EXPECT_EQ(validateMesh(empty).error().code, ErrorCode::kEmptyMesh);
+
+  TriangleMesh nan = makeBox({1, 1, 1});
+  nan.vertices[3].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(validateMesh(nan).error().code, ErrorCode::kNonFinite);
+  EXPECT_EQ(validateMesh(nan).error().message, "vertex 3 has a non-finite coordinate");
+
+  TriangleMesh inf = makeBox({1, 1, 1});
+  inf.vertices[0].x() = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(validateMesh(inf).error().code, ErrorCode::kNonFinite);
+
+  TriangleMesh range = makeBox({1, 1, 1});
+  range.triangles[7][2] = 8;
+  EXPECT_EQ(validateMesh(range).error().code, ErrorCode::kIndexOutOfRange);
+  EXPECT_EQ(validateMesh(range).error().message, "face 7 refers to vertex 8, but the mesh has 8 vertices");
+
+  TriangleMesh repeated = makeBox({1, 1, 1});
+  repeated.triangles.push_back({1, 1, 2});
+  EXPECT_EQ(validateMesh(repeated).error().code, ErrorCode::kDegenerateFace);
+  EXPECT_EQ(validateMesh(repeated).error().message, "1 degenerate face (first: face 12, repeated vertex)");
+  EXPECT_TRUE(validateMesh(repeated, {.allowDegenerateFaces = true}).ok());
+  EXPECT_EQ(removeRepeatedVertexFaces(repeated), 1u);
+  EXPECT_TRUE(validateMesh(repeated).ok());
+
+  TriangleMesh collinear = makeBox({1, 1, 1});
+  collinear.vertices.push_back(0.5 * (collinear.vertices[0] + collinear.vertices[7]));
+  collinear.triangles.push_back({0, 8, 7});
+  EXPECT_EQ(validateMesh(collinear).error().message, "1 degenerate face (first: face 12, zero area)");
+  const MeshDefects d = findDefects(collinear);
+  EXPECT_EQ(d.zeroAreaFaces, 1u);
+  EXPECT_EQ(d.repeatedVertexFaces, 0u);
+}
+
+}  // namespace
+}  // namespace shapedb::core

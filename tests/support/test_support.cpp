@@ -1,0 +1,65 @@
+#include "support/test_support.h"
+
+#include <atomic>
+#include <fstream>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+
+#include <shapedb/core/primitives.h>
+
+namespace shapedb::test {
+
+core::Mat3 randomRotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q.normalized().toRotationMatrix();
+}
+
+core::Mat4 randomSimilarity(std::mt19937_64& rng, double range, double minScale, double maxScale) {
+  std::uniform_real_distribution<double> offset(-range, range);
+  std::uniform_real_distribution<double> logScale(std::log(minScale), std::log(maxScale));
+  core::Mat4 t = core::Mat4::Identity();
+  t.topLeftCorner<3, 3>() = std::exp(logScale(rng)) * randomRotation(rng);
+  t.topRightCorner<3, 1>() = core::Vec3(offset(rng), offset(rng), offset(rng));
+  return t;
+}
+
+double maxVertexDifference(const core::TriangleMesh& a, const core::TriangleMesh& b, double scale) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.vertices.size(); ++i)
+    worst = std::max(worst, (a.vertices[i] - b.vertices[i]).cwiseAbs().maxCoeff());
+  return worst / scale;
+}
+
+core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions) {
+  core::TriangleMesh mesh = core::makeIcosphere(1.0, subdivisions);
+  // Tapers make it pear-shaped along x and along y; the bump breaks every remaining symmetry.
+  for (core::Vec3& p : mesh.vertices) {
+    const double bump = 1.0 + 0.1 * p.z() + 0.1 * p.x() * p.z() + 0.05 * p.y() * p.y();
+    p = core::Vec3(p.x(), p.y() * (1.0 + 0.5 * p.x()), p.z() * (1.0 + 0.4 * p.x()) * (1.0 + 0.45 * p.y())) *
+        bump;
+    p = radii.cwiseProduct(p);
+  }
+  return mesh;
+}
+
+ScratchDir::ScratchDir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  mPath = std::filesystem::temp_directory_path() /
+          ("shapedb-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  std::filesystem::remove_all(mPath);
+  std::filesystem::create_directories(mPath);
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(mPath, ec);
+}
+
+void writeFile(const std::filesystem::path& path, const std::string& content) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(content.data(), static_cast<std::streamsize>(content.size()));
+}
+
+}  // namespace shapedb::test

@@ -1,0 +1,46 @@
+#pragma once
+
+// Helpers shared by the test suites: seeded random transforms, scratch directories, mesh comparisons.
+
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include <shapedb/core/triangle_mesh.h>
+#include <shapedb/core/types.h>
+
+namespace shapedb::test {
+
+/// A uniformly distributed random rotation (unit quaternion from four normal deviates).
+core::Mat3 randomRotation(std::mt19937_64& rng);
+
+/// A random similarity transform: random rotation, translation in [-range, range]³, uniform scale in
+/// [minScale, maxScale] (log-uniform).
+core::Mat4 randomSimilarity(std::mt19937_64& rng, double range = 10.0, double minScale = 0.1,
+                            double maxScale = 10.0);
+
+/// Largest |a − b| over corresponding vertices, divided by `scale`. Precondition: same vertex count.
+double maxVertexDifference(const core::TriangleMesh& a, const core::TriangleMesh& b, double scale = 1.0);
+
+/// A closed blob with three distinct principal moments, skewed along every axis: an icosphere tapered
+/// along x and y (pear-shaped), bumped, and stretched by `radii`. No symmetry at all.
+core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions);
+
+/// A fresh empty directory under the system temp dir, removed when the object dies.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& tag);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return mPath; }
+  std::filesystem::path operator/(const std::string& name) const { return mPath / name; }
+
+ private:
+  std::filesystem::path mPath;
+};
+
+/// Writes `content` to `path` byte for byte.
+void writeFile(const std::filesystem::path& path, const std::string& content);
+
+}  // namespace shapedb::test
