@@ -2,7 +2,7 @@
 add_library(shapedb_warnings INTERFACE)
 target_compile_options(shapedb_warnings INTERFACE
   -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast -Wcast-align
-  -Woverloaded-virtual -Wnull-dereference -Wimplicit-fallthrough
+  -Woverloaded-virtual -Wimplicit-fallthrough
   $<$<BOOL:${SHAPEDB_WERROR}>:-Werror>)
 
 # shapedb_add_module(name SOURCES ... DEPENDS ...): one library per top-level folder, shapedb::<name>.

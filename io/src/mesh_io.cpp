@@ -1,11 +1,15 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <mutex>
+#include <sstream>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <shapedb/io/mesh_io.h>
@@ -60,6 +64,48 @@ Status checkStlFraming(const std::filesystem::path& path, std::uintmax_t fileSiz
   return fileError(path, ErrorCode::kParse, "not an STL file (too short for binary, no 'solid' for ASCII)");
 }
 
+// What a line-by-line look at a text mesh file finds before OpenMesh parses it.
+struct TextScan {
+  std::size_t vertexLines = 0;    // OBJ "v" lines
+  std::size_t nonFiniteLine = 0;  // first line with a NaN, infinite or overflowing number (1-based; 0 none)
+  std::string nonFiniteToken;
+};
+
+// OpenMesh's text readers skip or misread numbers they cannot parse as floats ("nan", "inf", "1e400"),
+// which shifts every later vertex. Find such numbers first, so the error says what is wrong and where.
+// Only data lines are scanned: comments and, for PLY, the header are skipped.
+TextScan scanText(const std::filesystem::path& path, const std::string& format) {
+  TextScan scan;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  bool inData = format != "ply";
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (!inData) {
+      if (line.rfind("format binary", 0) == 0) return scan;  // binary PLY: validated after reading
+      inData = line.rfind("end_header", 0) == 0;
+      continue;
+    }
+    std::istringstream words(line);
+    std::string word;
+    if (!(words >> word) || word[0] == '#') continue;
+    if (format == "obj") {
+      if (word != "v") continue;
+      ++scan.vertexLines;
+    } else {
+      words.seekg(0);
+    }
+    while (scan.nonFiniteLine == 0 && words >> word) {
+      char* end = nullptr;
+      const double value = std::strtod(word.c_str(), &end);
+      if (end == word.c_str() + word.size() && !std::isfinite(value)) {
+        scan.nonFiniteLine = number;
+        scan.nonFiniteToken = word;
+      }
+    }
+  }
+  return scan;
+}
+
 // Polygons fan-triangulated; polygons with fewer than three corners counted.
 struct Triangulated {
   core::TriangleMesh mesh;
@@ -85,6 +131,13 @@ Triangulated triangulate(detail::RawImporter&& raw) {
   return out;
 }
 
+// OpenMesh's writers need one of its own kernels; double-precision points so nothing is lost before
+// the writer formats them.
+struct DoubleTraits : OpenMesh::DefaultTraits {
+  using Point = OpenMesh::Vec3d;
+};
+using WritableMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
+
 }  // namespace
 
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options) {
@@ -105,6 +158,11 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   if (format == "stl") {
     if (Status framing = checkStlFraming(path, fileSize); !framing) return framing.error();
   }
+  const TextScan scan = format == "stl" ? TextScan{} : scanText(path, format);
+  if (scan.nonFiniteLine > 0)
+    return fileError(
+        path, ErrorCode::kNonFinite,
+        "line " + std::to_string(scan.nonFiniteLine) + ": non-finite number '" + scan.nonFiniteToken + "'");
 
   // Parse through OpenMesh into the raw importer; no OpenMesh exception crosses this function.
   detail::RawImporter raw;
@@ -121,6 +179,10 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
     }
   }
   if (!parsed) return fileError(path, ErrorCode::kParse, "could not parse as " + format);
+  if (format == "obj" && raw.vertices.size() != scan.vertexLines)
+    return fileError(path, ErrorCode::kParse,
+                     std::to_string(scan.vertexLines) + " vertex lines, but only " +
+                         std::to_string(raw.vertices.size()) + " could be parsed");
 
   // Triangulate, then validate what was read.
   Triangulated tri = triangulate(std::move(raw));
@@ -156,14 +218,26 @@ Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& pat
     return Error{ErrorCode::kInvalidArgument,
                  path.string() + ": refusing to write: " + valid.error().message};
 
-  detail::TriangleMeshExporter exporter(mesh);
   OpenMesh::IO::Options writeOptions;
   if (format == "ply" && options.binary) writeOptions += OpenMesh::IO::Options::Binary;
   bool written = false;
   {
     std::lock_guard lock(openMeshMutex());
+    // Copy into OpenMesh's kernel, which refuses faces that would make an edge non-manifold.
+    WritableMesh out;
+    out.reserve(mesh.vertices.size(), 3 * mesh.triangles.size(), mesh.triangles.size());
+    for (const core::Vec3& p : mesh.vertices)
+      out.add_vertex(OpenMesh::Vec3d(p.x(), p.y(), p.z()));
+    for (const auto& t : mesh.triangles) {
+      const auto face = out.add_face(OpenMesh::VertexHandle(static_cast<int>(t[0])),
+                                     OpenMesh::VertexHandle(static_cast<int>(t[1])),
+                                     OpenMesh::VertexHandle(static_cast<int>(t[2])));
+      if (!face.is_valid())
+        return Error{ErrorCode::kInvalidArgument,
+                     path.string() + ": refusing to write: OpenMesh cannot represent a non-manifold surface"};
+    }
     try {
-      written = OpenMesh::IO::IOManager().write(path.string(), exporter, writeOptions, 17);
+      written = OpenMesh::IO::write_mesh(out, path.string(), writeOptions, 17);
     } catch (...) {
       written = false;
     }

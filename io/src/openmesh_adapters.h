@@ -1,14 +1,13 @@
 #pragma once
 
-// Adapters between OpenMesh's file readers and writers and shapedb's TriangleMesh. OpenMesh's own mesh
-// kernels reject non-manifold faces while reading; these adapters keep every face exactly as the file
-// has it, so that topology is judged by shapedb (analyzeTopology), not silently repaired.
+// The adapter between OpenMesh's file readers and shapedb's TriangleMesh. OpenMesh's own mesh kernels
+// reject non-manifold faces while reading; this importer keeps every face exactly as the file has it,
+// so that topology is judged by shapedb (analyzeTopology), not silently repaired.
 
 #include <cstdint>
 #include <limits>
 #include <vector>
 
-#include <OpenMesh/Core/IO/exporter/BaseExporter.hh>
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 
 #include <shapedb/core/triangle_mesh.h>
@@ -85,77 +84,6 @@ class RawImporter final : public OpenMesh::IO::BaseImporter {
   void set_color(FH, const OpenMesh::Vec4f&) override {}
   void set_status(FH, const OpenMesh::Attributes::StatusInfo&) override {}
   void add_texture_information(int, std::string) override {}
-};
-
-/// Presents a TriangleMesh to OpenMesh's writers: positions (as doubles) and faces only.
-/// Borrows the mesh, which must outlive it. Precondition: every index is in range.
-class TriangleMeshExporter final : public OpenMesh::IO::BaseExporter {
- public:
-  using VH = OpenMesh::VertexHandle;
-  using FH = OpenMesh::FaceHandle;
-  using HH = OpenMesh::HalfedgeHandle;
-  using EH = OpenMesh::EdgeHandle;
-  using Status = OpenMesh::Attributes::StatusInfo;
-
-  explicit TriangleMeshExporter(const core::TriangleMesh& mesh) : mMesh(mesh) {}
-
-  OpenMesh::Vec3d pointd(VH vh) const override {
-    const core::Vec3& p = mMesh.vertices[static_cast<std::size_t>(vh.idx())];
-    return {p.x(), p.y(), p.z()};
-  }
-  OpenMesh::Vec3f point(VH vh) const override { return OpenMesh::Vec3f(pointd(vh)); }
-  bool is_point_double() const override { return true; }
-  unsigned int get_vhandles(FH fh, std::vector<VH>& handles) const override {
-    handles.clear();
-    for (std::uint32_t v : mMesh.triangles[static_cast<std::size_t>(fh.idx())])
-      handles.emplace_back(static_cast<int>(v));
-    return 3;
-  }
-  std::size_t n_vertices() const override { return mMesh.vertices.size(); }
-  std::size_t n_faces() const override { return mMesh.triangles.size(); }
-  std::size_t n_edges() const override { return 0; }
-  bool is_triangle_mesh() const override { return true; }
-
-  // Attributes shapedb does not write.
-  OpenMesh::Vec3f normal(VH) const override { return OpenMesh::Vec3f(0.0f, 0.0f, 0.0f); }
-  OpenMesh::Vec3d normald(VH) const override { return OpenMesh::Vec3d(0.0, 0.0, 0.0); }
-  bool is_normal_double() const override { return false; }
-  OpenMesh::Vec3uc color(VH) const override { return OpenMesh::Vec3uc(0, 0, 0); }
-  OpenMesh::Vec4uc colorA(VH) const override { return OpenMesh::Vec4uc(0, 0, 0, 0); }
-  OpenMesh::Vec3ui colori(VH) const override { return OpenMesh::Vec3ui(0u, 0u, 0u); }
-  OpenMesh::Vec4ui colorAi(VH) const override { return OpenMesh::Vec4ui(0u, 0u, 0u, 0u); }
-  OpenMesh::Vec3f colorf(VH) const override { return OpenMesh::Vec3f(0.0f, 0.0f, 0.0f); }
-  OpenMesh::Vec4f colorAf(VH) const override { return OpenMesh::Vec4f(0.0f, 0.0f, 0.0f, 0.0f); }
-  OpenMesh::Vec2f texcoord(VH) const override { return OpenMesh::Vec2f(0.0f, 0.0f); }
-  OpenMesh::Vec2f texcoord(HH) const override { return OpenMesh::Vec2f(0.0f, 0.0f); }
-  Status status(VH) const override { return {}; }
-  HH getHeh(FH, VH) const override { return HH(); }
-  unsigned int get_face_texcoords(std::vector<OpenMesh::Vec2f>&) const override { return 0; }
-  OpenMesh::Vec3f normal(FH) const override { return OpenMesh::Vec3f(0.0f, 0.0f, 0.0f); }
-  OpenMesh::Vec3d normald(FH) const override { return OpenMesh::Vec3d(0.0, 0.0, 0.0); }
-  OpenMesh::Vec3uc color(FH) const override { return OpenMesh::Vec3uc(0, 0, 0); }
-  OpenMesh::Vec4uc colorA(FH) const override { return OpenMesh::Vec4uc(0, 0, 0, 0); }
-  OpenMesh::Vec3ui colori(FH) const override { return OpenMesh::Vec3ui(0u, 0u, 0u); }
-  OpenMesh::Vec4ui colorAi(FH) const override { return OpenMesh::Vec4ui(0u, 0u, 0u, 0u); }
-  OpenMesh::Vec3f colorf(FH) const override { return OpenMesh::Vec3f(0.0f, 0.0f, 0.0f); }
-  OpenMesh::Vec4f colorAf(FH) const override { return OpenMesh::Vec4f(0.0f, 0.0f, 0.0f, 0.0f); }
-  Status status(FH) const override { return {}; }
-  OpenMesh::Vec3uc color(EH) const override { return OpenMesh::Vec3uc(0, 0, 0); }
-  OpenMesh::Vec4uc colorA(EH) const override { return OpenMesh::Vec4uc(0, 0, 0, 0); }
-  OpenMesh::Vec3ui colori(EH) const override { return OpenMesh::Vec3ui(0u, 0u, 0u); }
-  OpenMesh::Vec4ui colorAi(EH) const override { return OpenMesh::Vec4ui(0u, 0u, 0u, 0u); }
-  OpenMesh::Vec3f colorf(EH) const override { return OpenMesh::Vec3f(0.0f, 0.0f, 0.0f); }
-  OpenMesh::Vec4f colorAf(EH) const override { return OpenMesh::Vec4f(0.0f, 0.0f, 0.0f, 0.0f); }
-  Status status(EH) const override { return {}; }
-  int get_halfedge_id(VH) override { return -1; }
-  int get_halfedge_id(FH) override { return -1; }
-  int get_next_halfedge_id(HH) override { return -1; }
-  int get_to_vertex_id(HH) override { return -1; }
-  int get_face_id(HH) override { return -1; }
-  Status status(HH) const override { return {}; }
-
- private:
-  const core::TriangleMesh& mMesh;
 };
 
 }  // namespace shapedb::io::detail

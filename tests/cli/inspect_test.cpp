@@ -1,1 +1,115 @@
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/normalize.h>
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/mesh_io.h>
+
+#include "support/subprocess.h"
+#include "support/test_support.h"
+
+namespace shapedb {
+namespace {
+
+test::ProcessResult shapedb(const std::vector<std::string>& args) {
+  return test::runProcess(SHAPEDB_CLI, args);
+}
+
+TEST(CliInspect, JsonCarriesTheDocumentedFieldsAndMatchesTheLibrary) {
+  test::ScratchDir dir("cli");
+  const core::TriangleMesh blob = test::makeLopsidedBlob({1.0, 1.6, 0.7}, 3);
+  ASSERT_TRUE(io::saveMesh(blob, dir / "blob.ply").ok());
+
+  const test::ProcessResult run =
+      shapedb({"inspect", (dir / "blob.ply").string(), "--json", "--density", "2.5"});
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  for (const char* field : {"volume", "area", "center_of_mass", "inertia", "principal_moments",
+                            "principal_axes", "transform", "topology"})
+    EXPECT_TRUE(j.contains(field)) << field;
+
+  // Same numbers as the library on the mesh the file holds.
+  const io::LoadedMesh loaded = *io::loadMesh(dir / "blob.ply");
+  const core::MassProperties mp = *core::computeMassProperties(loaded.mesh, {.density = 2.5});
+  const core::Normalization n = *core::normalize(loaded.mesh, mp);
+  EXPECT_DOUBLE_EQ(j["volume"].get<double>(), mp.volume);
+  EXPECT_DOUBLE_EQ(j["mass"].get<double>(), 2.5 * mp.volume);
+  EXPECT_DOUBLE_EQ(j["area"].get<double>(), mp.area);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(j["center_of_mass"][i].get<double>(), mp.centerOfMass[i]);
+    EXPECT_DOUBLE_EQ(j["principal_moments"][i].get<double>(), n.principalMoments[i]);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_DOUBLE_EQ(j["inertia"][i][k].get<double>(), mp.inertia(i, k));
+      EXPECT_DOUBLE_EQ(j["principal_axes"][i][k].get<double>(), n.principalAxes(k, i));
+    }
+  }
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      EXPECT_DOUBLE_EQ(j["transform"][r][c].get<double>(), n.canonicalFromMesh(r, c));
+  EXPECT_EQ(j["topology"]["triangles"].get<std::size_t>(), blob.triangles.size());
+  EXPECT_TRUE(j["topology"]["is_closed"].get<bool>());
+  EXPECT_EQ(j["degeneracy"]["axes"], "none");
+  EXPECT_FALSE(j["approximate"].get<bool>());
+}
+
+TEST(CliInspect, FlagsASymmetricShape) {
+  test::ScratchDir dir("cli");
+  ASSERT_TRUE(io::saveMesh(core::makeIcosphere(1.0, 3), dir / "sphere.obj").ok());
+  const test::ProcessResult run = shapedb({"inspect", (dir / "sphere.obj").string(), "--json"});
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["degeneracy"]["axes"], "all");
+}
+
+TEST(CliInspect, TextReportNamesTheFileAndItsNumbers) {
+  test::ScratchDir dir("cli");
+  ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), dir / "box.obj").ok());
+  const test::ProcessResult run = shapedb({"inspect", (dir / "box.obj").string()});
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("box.obj (obj): 8 vertices, 12 triangles"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("volume           6 m³"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("closed, consistently oriented"), std::string::npos);
+}
+
+TEST(CliInspect, OpenMeshFailsWithOneLineUnlessApproximate) {
+  test::ScratchDir dir("cli");
+  test::writeFile(dir / "open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n");
+  const test::ProcessResult refused = shapedb({"inspect", (dir / "open.obj").string()});
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_EQ(refused.out, "");
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_NE(refused.err.find("open.obj: mesh is not closed (3 boundary edges)"), std::string::npos)
+      << refused.err;
+
+  const test::ProcessResult approx =
+      shapedb({"inspect", (dir / "open.obj").string(), "--approximate", "--json"});
+  ASSERT_EQ(approx.exitCode, 0) << approx.err;
+  const nlohmann::json j = nlohmann::json::parse(approx.out);
+  EXPECT_TRUE(j["approximate"].get<bool>());
+  EXPECT_EQ(j["topology"]["boundary_edges"].get<int>(), 3);
+}
+
+TEST(CliInspect, BadInputAndUsageGiveNonZeroExitAndAMessage) {
+  test::ScratchDir dir("cli");
+  const test::ProcessResult missing = shapedb({"inspect", (dir / "absent.stl").string()});
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("absent.stl: no such file"), std::string::npos) << missing.err;
+
+  EXPECT_EQ(shapedb({"inspect"}).exitCode, 2);
+  EXPECT_EQ(shapedb({"frobnicate"}).exitCode, 2);
+  EXPECT_EQ(shapedb({"inspect", (dir / "x.obj").string(), "--density", "-3"}).exitCode, 2);
+}
+
+TEST(CliInspect, HelpExplains) {
+  const test::ProcessResult top = shapedb({"--help"});
+  EXPECT_EQ(top.exitCode, 0);
+  EXPECT_NE(top.out.find("inspect"), std::string::npos);
+  const test::ProcessResult inspect = shapedb({"inspect", "--help"});
+  EXPECT_EQ(inspect.exitCode, 0);
+  for (const char* word : {"--json", "--density", "--approximate", "canonicalFromMesh"})
+    EXPECT_NE(inspect.out.find(word), std::string::npos) << word;
+}
+
+}  // namespace
+}  // namespace shapedb

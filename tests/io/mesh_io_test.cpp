@@ -1,1 +1,272 @@
+#include <cstring>
+#include <fstream>
+#include <sstream>
 
+#include <gtest/gtest.h>
+
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/mesh_io.h>
+
+#include "support/test_support.h"
+
+namespace shapedb::io {
+namespace {
+
+using core::TriangleMesh;
+using core::Vec3;
+
+// Writers for the formats shapedb only reads, so that tests can make real files of each.
+std::string offText(const TriangleMesh& mesh) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n";
+  for (const Vec3& p : mesh.vertices)
+    out << p.x() << " " << p.y() << " " << p.z() << "\n";
+  for (const auto& t : mesh.triangles)
+    out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+  return out.str();
+}
+
+std::string asciiStl(const TriangleMesh& mesh) {
+  std::ostringstream out;
+  out.precision(9);
+  out << "solid test\n";
+  for (const auto& t : mesh.triangles) {
+    out << "facet normal 0 0 0\nouter loop\n";
+    for (auto v : t)
+      out << "vertex " << mesh.vertices[v].x() << " " << mesh.vertices[v].y() << " " << mesh.vertices[v].z()
+          << "\n";
+    out << "endloop\nendfacet\n";
+  }
+  out << "endsolid test\n";
+  return out.str();
+}
+
+std::string binaryStl(const TriangleMesh& mesh, std::uint32_t claimedCount) {
+  std::string out(80, ' ');
+  out.append(reinterpret_cast<const char*>(&claimedCount), 4);
+  for (const auto& t : mesh.triangles) {
+    float record[12] = {};
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c)
+        record[3 + 3 * k + c] = static_cast<float>(mesh.vertices[t[k]][c]);
+    out.append(reinterpret_cast<const char*>(record), sizeof record);
+    out.append(2, '\0');
+  }
+  return out;
+}
+
+std::string binaryStl(const TriangleMesh& mesh) {
+  return binaryStl(mesh, static_cast<std::uint32_t>(mesh.triangles.size()));
+}
+
+LoadedMesh mustLoad(const std::filesystem::path& path, const LoadOptions& options = {}) {
+  Result<LoadedMesh> loaded = loadMesh(path, options);
+  EXPECT_TRUE(loaded.ok()) << loaded.error().message;
+  return loaded.ok() ? *loaded : LoadedMesh{};
+}
+
+Error mustFail(const std::filesystem::path& path, const LoadOptions& options = {}) {
+  Result<LoadedMesh> loaded = loadMesh(path, options);
+  EXPECT_FALSE(loaded.ok()) << path << " loaded but should not have";
+  if (loaded.ok()) return Error{ErrorCode::kIo, ""};
+  // Every message names the file.
+  EXPECT_EQ(loaded.error().message.rfind(path.string() + ": ", 0), 0u) << loaded.error().message;
+  return loaded.error();
+}
+
+double volumeOf(const TriangleMesh& mesh) {
+  Result<core::MassProperties> mp = core::computeMassProperties(mesh);
+  EXPECT_TRUE(mp.ok()) << mp.error().message;
+  return mp.ok() ? mp->volume : 0.0;
+}
+
+TEST(MeshIo, ObjAndPlyRoundTripToFloatPrecision) {
+  test::ScratchDir dir("io");
+  const TriangleMesh blob = test::makeLopsidedBlob({1.0, 1.6, 0.7}, 3);
+  for (const char* name : {"blob.obj", "blob.ply", "ascii.ply", "UPPER.OBJ"}) {
+    SCOPED_TRACE(name);
+    const bool binary = std::string(name) != "ascii.ply";
+    ASSERT_TRUE(saveMesh(blob, dir / name, {.binary = binary}).ok());
+    const LoadedMesh loaded = mustLoad(dir / name);
+    ASSERT_EQ(loaded.mesh.vertices.size(), blob.vertices.size());
+    EXPECT_EQ(loaded.mesh.triangles, blob.triangles);
+    EXPECT_LT(test::maxVertexDifference(loaded.mesh, blob), 2e-7);
+    EXPECT_TRUE(loaded.topology.isClosed());
+    EXPECT_TRUE(loaded.topology.isConsistentlyOriented());
+  }
+}
+
+TEST(MeshIo, ReadsOffAndBothStlFlavours) {
+  test::ScratchDir dir("io");
+  const TriangleMesh mesh = core::makeUvEllipsoid({1.0, 0.5, 0.25}, 16, 9);
+  test::writeFile(dir / "m.off", offText(mesh));
+  test::writeFile(dir / "ascii.stl", asciiStl(mesh));
+  test::writeFile(dir / "binary.stl", binaryStl(mesh));
+  const double volume = volumeOf(mesh);
+  for (const char* name : {"m.off", "ascii.stl", "binary.stl"}) {
+    SCOPED_TRACE(name);
+    const LoadedMesh loaded = mustLoad(dir / name);
+    // STL repeats corners per triangle; the reader merges them back into shared vertices.
+    EXPECT_EQ(loaded.mesh.vertices.size(), mesh.vertices.size());
+    EXPECT_EQ(loaded.mesh.triangles.size(), mesh.triangles.size());
+    EXPECT_TRUE(loaded.topology.isClosed());
+    EXPECT_TRUE(loaded.topology.isConsistentlyOriented());
+    EXPECT_NEAR(volumeOf(loaded.mesh), volume, 1e-6 * volume);  // STL stores floats
+  }
+}
+
+TEST(MeshIo, TriangulatesPolygons) {
+  test::ScratchDir dir("io");
+  test::writeFile(dir / "cube.obj",
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+                  "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
+  const LoadedMesh loaded = mustLoad(dir / "cube.obj");
+  EXPECT_EQ(loaded.mesh.triangles.size(), 12u);
+  EXPECT_EQ(loaded.polygonsTriangulated, 6u);
+  EXPECT_TRUE(loaded.topology.isClosed());
+  EXPECT_NEAR(volumeOf(loaded.mesh), 1.0, 1e-15);
+}
+
+TEST(MeshIo, KeepsNonManifoldFacesForTheTopologyReport) {
+  test::ScratchDir dir("io");
+  // A closed tetrahedron with a fin on edge 1-2.
+  test::writeFile(
+      dir / "fin.obj",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 2 5\n");
+  const LoadedMesh loaded = mustLoad(dir / "fin.obj");
+  EXPECT_EQ(loaded.mesh.triangles.size(), 5u);
+  EXPECT_EQ(loaded.topology.nonManifoldEdges, 1u);
+  EXPECT_EQ(loaded.topology.boundaryEdges, 2u);
+  // OpenMesh's kernel cannot hold it, so it cannot be written back: an error, not a silent repair.
+  EXPECT_EQ(saveMesh(loaded.mesh, dir / "fin_copy.obj").error().code, ErrorCode::kInvalidArgument);
+}
+
+TEST(MeshIo, MissingUnreadableOrUnknownFilesAreErrors) {
+  test::ScratchDir dir("io");
+  EXPECT_EQ(mustFail(dir / "absent.obj").code, ErrorCode::kIo);
+  std::filesystem::create_directories(dir / "folder.obj");
+  EXPECT_EQ(mustFail(dir / "folder.obj").code, ErrorCode::kIo);
+  test::writeFile(dir / "mesh.xyz", "v 0 0 0\n");
+  const Error unknown = mustFail(dir / "mesh.xyz");
+  EXPECT_EQ(unknown.code, ErrorCode::kUnknownFormat);
+  EXPECT_NE(unknown.message.find("unknown mesh format '.xyz'"), std::string::npos);
+  test::writeFile(dir / "noextension", "v 0 0 0\n");
+  EXPECT_EQ(mustFail(dir / "noextension").code, ErrorCode::kUnknownFormat);
+}
+
+TEST(MeshIo, EmptyGarbageAndTruncatedFilesOfEachFormatAreErrors) {
+  test::ScratchDir dir("io");
+  std::string garbage;
+  for (int i = 0; i < 4096; ++i)
+    garbage.push_back(static_cast<char>((i * 7919 + 13) % 256));
+  const TriangleMesh blob = test::makeLopsidedBlob({1.0, 1.6, 0.7}, 2);
+  ASSERT_TRUE(saveMesh(blob, dir / "whole.ply").ok());
+  ASSERT_TRUE(saveMesh(blob, dir / "whole_ascii.ply", {.binary = false}).ok());
+  ASSERT_TRUE(saveMesh(blob, dir / "whole.obj").ok());
+  std::ifstream plyIn(dir / "whole.ply", std::ios::binary);
+  const std::string ply((std::istreambuf_iterator<char>(plyIn)), {});
+  const std::string stl = binaryStl(blob);
+
+  for (const char* ext : {"obj", "ply", "off", "stl"}) {
+    SCOPED_TRACE(ext);
+    test::writeFile(dir / (std::string("empty.") + ext), "");
+    EXPECT_EQ(mustFail(dir / (std::string("empty.") + ext)).code, ErrorCode::kParse);
+    test::writeFile(dir / (std::string("garbage.") + ext), garbage);
+    const ErrorCode code = mustFail(dir / (std::string("garbage.") + ext)).code;
+    EXPECT_TRUE(code == ErrorCode::kParse || code == ErrorCode::kEmptyMesh ||
+                code == ErrorCode::kIndexOutOfRange)
+        << static_cast<int>(code);
+  }
+
+  // Binary STL cut short, or claiming more triangles than it holds (2³¹ among them).
+  test::writeFile(dir / "truncated.stl", stl.substr(0, stl.size() - 30));
+  const Error truncated = mustFail(dir / "truncated.stl");
+  EXPECT_EQ(truncated.code, ErrorCode::kParse);
+  EXPECT_NE(truncated.message.find("truncated or corrupt binary STL"), std::string::npos)
+      << truncated.message;
+  test::writeFile(dir / "liar.stl", binaryStl(blob, 1u << 31));
+  EXPECT_EQ(mustFail(dir / "liar.stl").code, ErrorCode::kParse);
+  test::writeFile(dir / "short.stl", stl.substr(0, 40));
+  EXPECT_EQ(mustFail(dir / "short.stl").code, ErrorCode::kParse);
+
+  // Binary PLY cut in its face list, and cut in its vertex list.
+  test::writeFile(dir / "truncated_faces.ply", ply.substr(0, ply.size() - 100));
+  mustFail(dir / "truncated_faces.ply");
+  test::writeFile(dir / "truncated_vertices.ply", ply.substr(0, ply.find("end_header") + 200));
+  mustFail(dir / "truncated_vertices.ply");
+}
+
+TEST(MeshIo, InvalidContentIsReportedWithItsCode) {
+  test::ScratchDir dir("io");
+  const std::string tet = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  const std::string faces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+  struct Case {
+    const char* name;
+    std::string content;
+    ErrorCode code;
+  };
+  const Case cases[] = {
+      {"nan.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + faces, ErrorCode::kNonFinite},
+      {"inf.obj", "v 0 0 inf\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + faces, ErrorCode::kNonFinite},
+      {"overflow.obj", "v 0 0 1e400\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + faces, ErrorCode::kNonFinite},
+      {"vertices_only.obj", tet, ErrorCode::kEmptyMesh},
+      {"out_of_range.obj", tet + faces + "f 1 2 9\n", ErrorCode::kIndexOutOfRange},
+      {"negative_out_of_range.obj", tet + faces + "f -1 -2 -9\n", ErrorCode::kIndexOutOfRange},
+      {"nan.off", "OFF\n4 4 0\n0 0 0\n1 0 nan\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n",
+       ErrorCode::kNonFinite},
+      {"inf.ply",
+       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 -inf\n0 1 0\n0 0 1\n"
+       "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n",
+       ErrorCode::kNonFinite},
+      {"unparsable_vertex.obj", "v 0 0 zero\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + faces, ErrorCode::kParse},
+      {"repeated.off",
+       "OFF\n4 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 0 0 1\n",
+       ErrorCode::kDegenerateFace},
+      {"collinear.obj", tet + "v 0.5 0 0\n" + faces + "f 1 5 2\n", ErrorCode::kDegenerateFace},
+      {"out_of_range.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 7\n", ErrorCode::kIndexOutOfRange},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    test::writeFile(dir / c.name, c.content);
+    const Error error = mustFail(dir / c.name);
+    EXPECT_EQ(error.code, c.code) << error.message;
+  }
+}
+
+TEST(MeshIo, ObjReaderDropsRepeatedVertexFacesItself) {
+  // OpenMesh's OBJ reader removes a face such as "f 1 1 2" while parsing; it never reaches shapedb.
+  test::ScratchDir dir("io");
+  test::writeFile(dir / "tet.obj",
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 1 2\n");
+  const LoadedMesh loaded = mustLoad(dir / "tet.obj");
+  EXPECT_EQ(loaded.mesh.triangles.size(), 4u);
+  EXPECT_TRUE(loaded.topology.isClosed());
+}
+
+TEST(MeshIo, DegenerateFacesAreAcceptedOnlyWhenAsked) {
+  test::ScratchDir dir("io");
+  test::writeFile(dir / "tet.off",
+                  "OFF\n4 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 0 0 1\n");
+  EXPECT_EQ(mustFail(dir / "tet.off").code, ErrorCode::kDegenerateFace);
+  const LoadedMesh loaded = mustLoad(dir / "tet.off", {.allowDegenerateFaces = true});
+  EXPECT_EQ(loaded.facesDropped, 1u);
+  EXPECT_EQ(loaded.defects.repeatedVertexFaces, 1u);
+  EXPECT_EQ(loaded.mesh.triangles.size(), 4u);
+  EXPECT_TRUE(loaded.topology.isClosed());
+}
+
+TEST(MeshIo, SaveRejectsUnknownFormatsAndInvalidMeshes) {
+  test::ScratchDir dir("io");
+  const TriangleMesh box = core::makeBox({1, 1, 1});
+  EXPECT_EQ(saveMesh(box, dir / "box.stl").error().code, ErrorCode::kUnknownFormat);
+  TriangleMesh bad = box;
+  bad.triangles[0][0] = 99;
+  EXPECT_EQ(saveMesh(bad, dir / "bad.obj").error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(saveMesh(box, dir / "missing_folder" / "box.obj").error().code, ErrorCode::kIo);
+}
+
+}  // namespace
+}  // namespace shapedb::io

@@ -27,7 +27,8 @@ struct LoadedMesh {
 };
 
 /// Reads an OBJ, PLY (ASCII or binary), OFF or STL (ASCII or binary) file through OpenMesh, chosen by
-/// extension (case-insensitive). Polygons are fan-triangulated; vertices are kept as the file has them
+/// extension (case-insensitive), coordinates in single precision as OpenMesh's readers parse them.
+/// Polygons are fan-triangulated; vertices are kept as the file has them
 /// (STL's duplicated corners are merged by OpenMesh's reader). Every error names the file:
 /// "part.stl: truncated binary STL (header says 12 triangles, file holds 3)". Errors: kIo, kUnknownFormat,
 /// kParse, kEmptyMesh, kNonFinite, kIndexOutOfRange, kDegenerateFace. Thread-safe.
@@ -38,9 +39,10 @@ struct SaveOptions {
   bool binary = true;  ///< PLY only: binary little-endian (exact doubles) rather than ASCII
 };
 
-/// Writes an OBJ or PLY file through OpenMesh, chosen by extension. Coordinates are written as doubles
-/// (OBJ with 17 significant digits), so a mesh read back is the same mesh. Errors: kUnknownFormat,
-/// kIo, kInvalidArgument (a mesh that fails validateMesh). Thread-safe.
+/// Writes an OBJ or PLY file through OpenMesh, chosen by extension. OpenMesh's readers parse single
+/// precision, so a mesh read back matches to float precision (~6e-8 relative). Errors: kUnknownFormat,
+/// kIo, kInvalidArgument (a mesh that fails validateMesh, or a non-manifold one, which OpenMesh's
+/// kernel cannot hold). Thread-safe.
 Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& path,
                 const SaveOptions& options = {});
 
