@@ -1,4 +1,5 @@
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 
@@ -9,21 +10,36 @@ namespace {
 
 // Third moments ∫(u·(p−c))³ dV along two axes, by the fan of tetrahedra from c. For a simplex with a
 // vertex at c and the others at wᵢ = u·(vᵢ − c): ∫(u·p)³ dV = V/20 · h₃(w₁, w₂, w₃), h₃ the complete
-// homogeneous symmetric polynomial of degree 3 (the Dirichlet integral over the simplex).
+// homogeneous symmetric polynomial of degree 3 (the Dirichlet integral over the simplex); by Newton's
+// identities 6 h₃ = p₁³ + 3 p₁ p₂ + 2 p₃, with pₖ the power sums of the wᵢ.
 std::array<double, 2> thirdMomentsExact(const TriangleMesh& mesh, const Vec3& c, const Vec3& ux,
                                         const Vec3& uy) {
-  auto h3 = [](double w1, double w2, double w3) {
-    return w1 * w1 * (w1 + w2 + w3) + w2 * w2 * (w2 + w1 + w3) + w3 * w3 * (w3 + w1 + w2) + w1 * w2 * w3;
+  // Every vertex once in the frame (ux, uy, ux × uy) about c; determinants do not depend on the frame.
+  thread_local std::vector<Vec3> local;
+  local.resize(mesh.vertices.size());
+  Mat3 frameFromMesh;
+  frameFromMesh.row(0) = ux;
+  frameFromMesh.row(1) = uy;
+  frameFromMesh.row(2) = ux.cross(uy);
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    local[i] = frameFromMesh * (mesh.vertices[i] - c);
+  const auto sixH3 = [](double w1, double w2, double w3) {
+    const double p1 = w1 + w2 + w3, p2 = w1 * w1 + w2 * w2 + w3 * w3,
+                 p3 = w1 * w1 * w1 + w2 * w2 * w2 + w3 * w3 * w3;
+    return p1 * p1 * p1 + 3.0 * p1 * p2 + 2.0 * p3;
   };
   double sumX = 0.0, sumY = 0.0;
+  const Vec3* q = local.data();
   for (const auto& t : mesh.triangles) {
-    const Vec3 a = mesh.vertices[t[0]] - c, b = mesh.vertices[t[1]] - c, d = mesh.vertices[t[2]] - c;
+    const Vec3& a = q[t[0]];
+    const Vec3& b = q[t[1]];
+    const Vec3& d = q[t[2]];
     const double det = a.dot(b.cross(d));
-    sumX += det * h3(ux.dot(a), ux.dot(b), ux.dot(d));
-    sumY += det * h3(uy.dot(a), uy.dot(b), uy.dot(d));
+    sumX += det * sixH3(a.x(), b.x(), d.x());
+    sumY += det * sixH3(a.y(), b.y(), d.y());
   }
-  // det/6 is the tet volume, and V/20 · h₃ = det/120 · h₃.
-  return {sumX / 120.0, sumY / 120.0};
+  // det/6 is the tet volume, so V/20 · h₃ = det/720 · 6 h₃.
+  return {sumX / 720.0, sumY / 720.0};
 }
 
 // The same moments for the approximate (vertex point-mass) properties, weights a third of the area.
