@@ -57,16 +57,10 @@ VolumeIntegrals integrateFan(const TriangleMesh& mesh, const Vec3& reference) {
 // over the vertices, each weighted by a third of its triangles' area; the volume estimated by the fan
 // from the area-weighted centroid, which is exact when the surface is in fact closed.
 Result<MassProperties> approximateFromVertices(const TriangleMesh& mesh, double density) {
-  std::vector<double> weight(mesh.vertices.size(), 0.0);
+  const std::vector<double> weight = vertexAreaWeights(mesh);
   double totalWeight = 0.0;
-  for (const auto& t : mesh.triangles) {
-    const double third =
-        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm() /
-        6.0;
-    for (std::uint32_t v : t)
-      weight[v] += third;
-    totalWeight += 3.0 * third;
-  }
+  for (double w : weight)
+    totalWeight += w;
   if (!(totalWeight > 0.0)) return Error{ErrorCode::kZeroVolume, "mesh has zero surface area"};
 
   Vec3 centroid = Vec3::Zero();
@@ -97,6 +91,17 @@ Result<MassProperties> approximateFromVertices(const TriangleMesh& mesh, double 
 }
 
 }  // namespace
+
+std::vector<double> vertexAreaWeights(const TriangleMesh& mesh) {
+  std::vector<double> weight(mesh.vertices.size(), 0.0);
+  for (const auto& t : mesh.triangles) {
+    const Vec3& a = mesh.vertices[t[0]];
+    const double third = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm() / 6.0;
+    for (std::uint32_t v : t)
+      weight[v] += third;
+  }
+  return weight;
+}
 
 Result<MassProperties> computeMassProperties(const TriangleMesh& mesh, const TopologyReport& topology,
                                              const MassPropertiesOptions& options) {

@@ -42,22 +42,18 @@ std::array<double, 2> thirdMomentsExact(const TriangleMesh& mesh, const Vec3& c,
   return {sumX / 720.0, sumY / 720.0};
 }
 
-// The same moments for the approximate (vertex point-mass) properties, weights a third of the area.
+// The same moments for the approximate properties: the vertex point masses, scaled to a volume
+// integral as the approximate inertia was.
 std::array<double, 2> thirdMomentsOfVertices(const TriangleMesh& mesh, const MassProperties& mp,
                                              const Vec3& ux, const Vec3& uy) {
+  const std::vector<double> weight = vertexAreaWeights(mesh);
   double sumX = 0.0, sumY = 0.0, total = 0.0;
-  for (const auto& t : mesh.triangles) {
-    const double third =
-        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm() /
-        6.0;
-    for (std::uint32_t v : t) {
-      const Vec3 r = mesh.vertices[v] - mp.centerOfMass;
-      sumX += third * std::pow(ux.dot(r), 3);
-      sumY += third * std::pow(uy.dot(r), 3);
-    }
-    total += 3.0 * third;
+  for (std::size_t v = 0; v < weight.size(); ++v) {
+    const Vec3 r = mesh.vertices[v] - mp.centerOfMass;
+    sumX += weight[v] * std::pow(ux.dot(r), 3);
+    sumY += weight[v] * std::pow(uy.dot(r), 3);
+    total += weight[v];
   }
-  // Scale to a volume integral, as the approximate inertia was.
   const double toVolume = mp.volume / total;
   return {sumX * toVolume, sumY * toVolume};
 }

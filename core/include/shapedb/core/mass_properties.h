@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include <shapedb/core/result.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/core/triangle_mesh.h>
@@ -41,6 +43,10 @@ Result<MassProperties> computeMassProperties(const TriangleMesh& mesh, const Top
 /// As above, analyzing the topology first (O(F log F)); use the overload above when the report is at hand.
 Result<MassProperties> computeMassProperties(const TriangleMesh& mesh,
                                              const MassPropertiesOptions& options = {});
+
+/// The paper's point masses (§4.1), lumped by area: each vertex gets a third of the area of every
+/// triangle it belongs to, m². Sums to the surface area. Used by the approximate fallback.
+std::vector<double> vertexAreaWeights(const TriangleMesh& mesh);
 
 /// Inertia tensor about the centre of mass from the volume covariance C = ∫ρ (p-c)(p-c)ᵀ dV:
 /// I = tr(C)·Id − C.
