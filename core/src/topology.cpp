@@ -120,53 +120,56 @@ Status requireClosedOriented(const TopologyReport& topology) {
 }
 
 MeshDefects findDefects(const TriangleMesh& mesh) {
-  MeshDefects defects;
-  for (const Vec3& p : mesh.vertices)
-    if (!p.allFinite()) ++defects.nonFiniteVertices;
-  for (const auto& t : mesh.triangles) {
-    const bool inRange =
-        t[0] < mesh.vertices.size() && t[1] < mesh.vertices.size() && t[2] < mesh.vertices.size();
-    if (!inRange) {
-      ++defects.outOfRangeIndices;
-    } else if (hasRepeatedVertex(t)) {
-      ++defects.repeatedVertexFaces;
-    } else if (hasZeroArea(mesh, t)) {
-      ++defects.zeroAreaFaces;
-    }
+  MeshDefects d;
+  d.vertexCount = mesh.vertices.size();
+  d.triangleCount = mesh.triangles.size();
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (mesh.vertices[v].allFinite()) continue;
+    if (d.nonFiniteVertices++ == 0) d.firstNonFiniteVertex = v;
   }
-  return defects;
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    const auto outside =
+        std::find_if(t.begin(), t.end(), [&](std::uint32_t i) { return i >= d.vertexCount; });
+    if (outside != t.end()) {
+      if (d.outOfRangeIndices++ == 0) {
+        d.firstOutOfRangeFace = f;
+        d.firstOutOfRangeIndex = *outside;
+      }
+      continue;
+    }
+    const bool repeated = hasRepeatedVertex(t);
+    if (!repeated && !hasZeroArea(mesh, t)) continue;
+    if (d.repeatedVertexFaces + d.zeroAreaFaces == 0) {
+      d.firstDegenerateFace = f;
+      d.firstDegenerateIsRepeated = repeated;
+    }
+    ++(repeated ? d.repeatedVertexFaces : d.zeroAreaFaces);
+  }
+  return d;
+}
+
+Status checkDefects(const MeshDefects& d, const ValidationOptions& options) {
+  if (d.triangleCount == 0) return Error{ErrorCode::kEmptyMesh, "mesh has no faces"};
+  if (d.nonFiniteVertices > 0)
+    return Error{ErrorCode::kNonFinite,
+                 "vertex " + std::to_string(d.firstNonFiniteVertex) + " has a non-finite coordinate"};
+  if (d.outOfRangeIndices > 0)
+    return Error{ErrorCode::kIndexOutOfRange,
+                 "face " + std::to_string(d.firstOutOfRangeFace) + " refers to vertex " +
+                     std::to_string(d.firstOutOfRangeIndex) + ", but the mesh has " +
+                     plural(d.vertexCount, "vertex", "vertices")};
+  const std::size_t degenerate = d.repeatedVertexFaces + d.zeroAreaFaces;
+  if (degenerate > 0 && !options.allowDegenerateFaces)
+    return Error{ErrorCode::kDegenerateFace,
+                 plural(degenerate, "degenerate face") + " (first: face " +
+                     std::to_string(d.firstDegenerateFace) + ", " +
+                     (d.firstDegenerateIsRepeated ? "repeated vertex" : "zero area") + ")"};
+  return Ok{};
 }
 
 Status validateMesh(const TriangleMesh& mesh, const ValidationOptions& options) {
-  if (mesh.triangles.empty()) return Error{ErrorCode::kEmptyMesh, "mesh has no faces"};
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-    if (!mesh.vertices[v].allFinite())
-      return Error{ErrorCode::kNonFinite, "vertex " + std::to_string(v) + " has a non-finite coordinate"};
-  }
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    for (std::uint32_t index : mesh.triangles[f]) {
-      if (index >= mesh.vertices.size())
-        return Error{ErrorCode::kIndexOutOfRange, "face " + std::to_string(f) + " refers to vertex " +
-                                                      std::to_string(index) + ", but the mesh has " +
-                                                      plural(mesh.vertices.size(), "vertex", "vertices")};
-    }
-  }
-  if (options.allowDegenerateFaces) return Ok{};
-  // Degenerate faces: report the count and the first one, so the user can find it.
-  std::size_t count = 0, first = 0;
-  const char* why = "";
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    const bool repeated = hasRepeatedVertex(mesh.triangles[f]);
-    if (!repeated && !hasZeroArea(mesh, mesh.triangles[f])) continue;
-    if (count++ == 0) {
-      first = f;
-      why = repeated ? "repeated vertex" : "zero area";
-    }
-  }
-  if (count > 0)
-    return Error{ErrorCode::kDegenerateFace, plural(count, "degenerate face") + " (first: face " +
-                                                 std::to_string(first) + ", " + why + ")"};
-  return Ok{};
+  return checkDefects(findDefects(mesh), options);
 }
 
 std::size_t removeRepeatedVertexFaces(TriangleMesh& mesh) {

@@ -195,10 +195,10 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   out.format = format;
   out.polygonsTriangulated = tri.polygons;
   out.facesDropped = tri.tooFewCorners;
-  if (Status valid = core::validateMesh(out.mesh, {.allowDegenerateFaces = options.allowDegenerateFaces});
+  out.defects = core::findDefects(out.mesh);
+  if (Status valid = core::checkDefects(out.defects, {.allowDegenerateFaces = options.allowDegenerateFaces});
       !valid)
     return withContext(valid.error(), path.string());
-  out.defects = core::findDefects(out.mesh);
   if (options.allowDegenerateFaces) {
     out.facesDropped += core::removeRepeatedVertexFaces(out.mesh);
     if (out.mesh.triangles.empty())
@@ -215,8 +215,7 @@ Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& pat
     return fileError(path, ErrorCode::kUnknownFormat,
                      "cannot write format '" + path.extension().string() + "' (expected .obj or .ply)");
   if (Status valid = core::validateMesh(mesh, {.allowDegenerateFaces = true}); !valid)
-    return Error{ErrorCode::kInvalidArgument,
-                 path.string() + ": refusing to write: " + valid.error().message};
+    return fileError(path, ErrorCode::kInvalidArgument, "refusing to write: " + valid.error().message);
 
   OpenMesh::IO::Options writeOptions;
   if (format == "ply" && options.binary) writeOptions += OpenMesh::IO::Options::Binary;
@@ -233,8 +232,8 @@ Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& pat
                                      OpenMesh::VertexHandle(static_cast<int>(t[1])),
                                      OpenMesh::VertexHandle(static_cast<int>(t[2])));
       if (!face.is_valid())
-        return Error{ErrorCode::kInvalidArgument,
-                     path.string() + ": refusing to write: OpenMesh cannot represent a non-manifold surface"};
+        return fileError(path, ErrorCode::kInvalidArgument,
+                         "refusing to write: OpenMesh cannot represent a non-manifold surface");
     }
     try {
       written = OpenMesh::IO::write_mesh(out, path.string(), writeOptions, 17);

@@ -43,19 +43,31 @@ struct ValidationOptions {
 };
 
 /// Per-mesh counts of the defects validateMesh looks for.
+/// Each count comes with its first offender, so that an error can point at it.
 struct MeshDefects {
+  std::size_t vertexCount = 0;
+  std::size_t triangleCount = 0;
   std::size_t nonFiniteVertices = 0;
-  std::size_t outOfRangeIndices = 0;
+  std::size_t outOfRangeIndices = 0;    ///< faces with at least one index ≥ vertexCount
   std::size_t repeatedVertexFaces = 0;  ///< faces such as (a, a, b)
   std::size_t zeroAreaFaces = 0;        ///< distinct vertices, but collinear or coincident
+  std::size_t firstNonFiniteVertex = 0;
+  std::size_t firstOutOfRangeFace = 0;
+  std::uint32_t firstOutOfRangeIndex = 0;  ///< the offending index in that face
+  std::size_t firstDegenerateFace = 0;     ///< first repeated-vertex or zero-area face
+  bool firstDegenerateIsRepeated = false;
 };
 
-/// Counts the defects of a mesh. Never fails; out-of-range faces are skipped by the area test.
+/// Counts the defects of a mesh in one pass over its vertices and faces. Never fails; out-of-range
+/// faces are skipped by the degeneracy tests.
 MeshDefects findDefects(const TriangleMesh& mesh);
+
+/// The error validateMesh reports for these defects, or Ok.
+Status checkDefects(const MeshDefects& defects, const ValidationOptions& options = {});
 
 /// Checks that a mesh can be processed: vertices and faces present, all coordinates finite, all
 /// indices in range, no degenerate face (unless allowed). The error names the first offender:
-/// "face 7 refers to vertex 120, but the mesh has 100 vertices".
+/// "face 7 refers to vertex 120, but the mesh has 100 vertices". Same as checkDefects(findDefects(mesh)).
 Status validateMesh(const TriangleMesh& mesh, const ValidationOptions& options = {});
 
 /// Removes faces with a repeated vertex index (they have no area and no proper edges) and returns how
