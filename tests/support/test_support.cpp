@@ -32,18 +32,6 @@ double maxVertexDifference(const core::TriangleMesh& a, const core::TriangleMesh
   return worst / scale;
 }
 
-core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions) {
-  core::TriangleMesh mesh = core::makeIcosphere(1.0, subdivisions);
-  // Tapers make it pear-shaped along x and along y; the bump breaks every remaining symmetry.
-  for (core::Vec3& p : mesh.vertices) {
-    const double bump = 1.0 + 0.1 * p.z() + 0.1 * p.x() * p.z() + 0.05 * p.y() * p.y();
-    p = core::Vec3(p.x(), p.y() * (1.0 + 0.5 * p.x()), p.z() * (1.0 + 0.4 * p.x()) * (1.0 + 0.45 * p.y())) *
-        bump;
-    p = radii.cwiseProduct(p);
-  }
-  return mesh;
-}
-
 ScratchDir::ScratchDir(const std::string& tag) {
   static std::atomic<int> counter{0};
   mPath = std::filesystem::temp_directory_path() /

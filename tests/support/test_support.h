@@ -9,6 +9,8 @@
 #include <shapedb/core/triangle_mesh.h>
 #include <shapedb/core/types.h>
 
+#include "synthetic.h"
+
 namespace shapedb::test {
 
 /// A uniformly distributed random rotation (unit quaternion from four normal deviates).
@@ -21,10 +23,6 @@ core::Mat4 randomSimilarity(std::mt19937_64& rng, double range = 10.0, double mi
 
 /// Largest |a − b| over corresponding vertices, divided by `scale`. Precondition: same vertex count.
 double maxVertexDifference(const core::TriangleMesh& a, const core::TriangleMesh& b, double scale = 1.0);
-
-/// A closed blob with three distinct principal moments, skewed along every axis: an icosphere tapered
-/// along x and y (pear-shaped), bumped, and stretched by `radii`. No symmetry at all.
-core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions);
 
 /// A fresh empty directory under the system temp dir, removed when the object dies.
 class ScratchDir {

@@ -1,0 +1,159 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <shapedb/core/descriptor.h>
+#include <shapedb/core/result.h>
+#include <shapedb/core/types.h>
+
+namespace shapedb::core {
+
+/// A database entry's identifier (its row in the store).
+using EntryId = std::uint32_t;
+
+/// Filled-cell counts of a voxel descriptor per part of four partitions of its grid: the slabs along
+/// x, y and z (16 bins each) and a 4³ block grid. Any partition bounds eq. (5) and (6) from below.
+struct CountProfile {
+  std::array<std::uint8_t, 48> slabs{};
+  std::array<std::uint8_t, 64> blocks{};
+};
+
+/// One search result.
+struct Match {
+  EntryId entry = 0;
+  double distance = 0.0;  ///< the descriptor's similarity (eq. 4, 5 or 6), smaller is closer
+  int candidate = 0;      ///< which query candidate (orientation) reached that distance
+  /// That candidate's rotation, candidateFromCanonical of the query: entry canonical ≈ orientation · T.
+  Mat3 orientation = Mat3::Identity();
+};
+
+/// How the index is searched. All methods but kBuckets return exactly the brute-force answer.
+enum class SearchMethod {
+  kBruteForce,  ///< every entry (TBB-parallel): the oracle
+  kPruned,      ///< exact: provable lower bounds skip entries that cannot enter the k best
+  kBuckets,     ///< the paper's §5 heuristic: only entries within ±r filled cells of the query; may miss.
+                ///< Voxel kinds only: a moment index is always searched exactly (its k-d tree)
+};
+
+struct SearchOptions {
+  int k = 1;                                    ///< number of matches, best first; ≥ 1
+  SearchMethod method = SearchMethod::kPruned;  ///<
+  int bucketRadius = 6;                         ///< kBuckets: r, the paper's 6
+  /// Use TBB within the search: brute force always, pruned search once its nearest buckets are done and
+  /// more remain. Off for many concurrent small queries. The answer does not depend on it.
+  bool parallel = true;
+};
+
+/// What a search did, for benchmarks and tests.
+struct SearchStats {
+  std::size_t distanceEvaluations = 0;  ///< full descriptor distances computed
+  std::size_t boundEvaluations = 0;     ///< per-entry (or per-node) lower bounds computed
+};
+
+/// The descriptors of every database entry in RAM, in a compact layout, with k-nearest search.
+///
+/// Layout (voxel kinds): entries sorted by filled-cell count; per entry the occupancy bit-packed
+/// (⌈N³/64⌉ words), its filled-cell counts per slab and per block (CountProfile, the lower bounds),
+/// and for centroid-voxel the centroid of each filled cell quantized to 5 bits per axis (2 bytes).
+/// Moment descriptors: a k-d tree over the three moments.
+///
+/// Distances are those of core::descriptorDistance on the quantized centroids (each coordinate moves
+/// by at most 1/64 of a cell), for every search method alike. Ties break by entry id, so results do not
+/// depend on the method's order of work or on the thread count.
+///
+/// Immutable once built; search is thread-safe. Build it with IndexBuilder.
+class Index {
+ public:
+  /// An empty index of descriptors with these options.
+  explicit Index(const DescriptorOptions& options = {});
+
+  /// The k entries nearest to the query (k or fewer if the index is smaller), best first, ties by
+  /// entry id. With several candidates (the query under each orientation candidate, as
+  /// volume::Describer::describeCandidates makes them) an entry's distance is the least over the
+  /// candidates, and the match records which candidate gave it (the lowest on ties).
+  /// Errors: kInvalidArgument if no candidate, k < 1, or a candidate of another kind, sampling or
+  /// grid size than the index.
+  Result<std::vector<Match>> search(std::span<const Descriptor> candidates, const SearchOptions& options = {},
+                                    SearchStats* stats = nullptr) const;
+  Result<std::vector<Match>> search(const Descriptor& query, const SearchOptions& options = {},
+                                    SearchStats* stats = nullptr) const {
+    return search(std::span<const Descriptor>(&query, 1), options, stats);
+  }
+
+  const DescriptorOptions& options() const { return mOptions; }
+  std::size_t size() const { return mIds.size(); }
+  /// Bytes held by the index's arrays.
+  std::size_t memoryBytes() const;
+
+  /// Filled-cell count of the entry at position `slot` (entries sorted by count); for tests.
+  std::uint32_t slotCount(std::size_t slot) const { return mCounts[slot]; }
+
+ private:
+  friend class IndexBuilder;
+  struct Query;
+  class TopK;
+
+  std::uint32_t words() const { return mWords; }
+  Query prepare(const Descriptor& descriptor, int candidate) const;
+  double gridDistance(const Query& q, std::size_t slot, double threshold) const;
+  double gridBound(const Query& q, std::size_t slot) const;
+  double countBound(const Query& q, std::uint32_t count) const;
+  void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
+  void searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const;
+  void searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const;
+
+  DescriptorOptions mOptions;
+  std::uint32_t mWords = 0;   ///< 64-bit words of occupancy per entry
+  std::vector<EntryId> mIds;  ///< per slot
+  // Voxel kinds, per slot.
+  std::vector<std::uint32_t> mCounts;
+  std::vector<std::uint64_t> mBits;
+  std::vector<CountProfile> mProfiles;
+  std::vector<std::uint64_t> mCentroidBegin;  ///< size() + 1 offsets into mCentroids
+  std::vector<std::uint16_t> mCentroids;
+  std::vector<std::uint32_t> mBucketBegin;  ///< first slot of each filled-cell count, N³ + 2 entries
+  // Moment kind: points in k-d tree order.
+  struct Node {
+    std::uint32_t begin, end;
+    std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
+    int axis = 0;
+    double split = 0.0;
+  };
+  std::vector<Vec3> mMoments;
+  std::vector<Node> mNodes;
+};
+
+/// Collects entries and builds an Index. One per build; not thread-safe.
+class IndexBuilder {
+ public:
+  explicit IndexBuilder(const DescriptorOptions& options);
+
+  /// Adds one entry; the descriptor is compacted at once and not kept.
+  /// Errors: kInvalidArgument for a descriptor of another kind, sampling or grid size.
+  Status add(EntryId id, const Descriptor& descriptor);
+  std::size_t size() const { return mIds.size(); }
+
+  /// The index of every entry added. Errors: kInvalidArgument if an id was added twice.
+  Result<Index> build() &&;
+
+ private:
+  DescriptorOptions mOptions;
+  std::uint32_t mWords = 0;
+  std::vector<EntryId> mIds;
+  std::vector<std::uint32_t> mCounts;
+  std::vector<std::uint64_t> mBits;
+  std::vector<std::uint64_t> mCentroidBegin{0};
+  std::vector<std::uint16_t> mCentroids;
+  std::vector<Vec3> mMoments;
+};
+
+/// A centroid in its cell's unit cube, quantized to 5 bits per axis (x in the low bits).
+std::uint16_t quantizeCentroid(const Vec3& centroid);
+Vec3 dequantizeCentroid(std::uint16_t code);
+
+const char* toString(SearchMethod method);
+
+}  // namespace shapedb::core

@@ -1,0 +1,577 @@
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <shapedb/core/index.h>
+
+namespace shapedb::core {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr int kProfileBins = 16;
+constexpr int kBlocksPerAxis = 4;  // the coarse 4³ block grid of the third bound
+constexpr int kQuantLevels = 32;
+constexpr int kMaxSquaredCode = 3 * (kQuantLevels - 1) * (kQuantLevels - 1);
+constexpr std::size_t kLeafSize = 8;
+
+// Centroid terms are summed as integers in units of 2⁻¹⁶: exact, order-free, and a one-cycle add
+// where a floating-point sum would chain its latency through every cell.
+constexpr double kTermUnit = 1.0 / 65536.0;
+
+// ‖Δ‖ / √3 in units of kTermUnit for every squared distance between two quantized centroids.
+const std::array<std::uint32_t, kMaxSquaredCode + 1>& centroidDistanceTable() {
+  static const auto table = [] {
+    std::array<std::uint32_t, kMaxSquaredCode + 1> t{};
+    for (int i = 0; i <= kMaxSquaredCode; ++i)
+      t[static_cast<std::size_t>(i)] =
+          static_cast<std::uint32_t>(std::lround(std::sqrt(i) / (kQuantLevels * std::sqrt(3.0)) / kTermUnit));
+    return t;
+  }();
+  return table;
+}
+
+inline int squaredCodeDistance(std::uint16_t a, std::uint16_t b) {
+  const int dx = (a & 31) - (b & 31), dy = ((a >> 5) & 31) - ((b >> 5) & 31),
+            dz = ((a >> 10) & 31) - ((b >> 10) & 31);
+  return dx * dx + dy * dy + dz * dz;
+}
+
+// Filled cells per part of four partitions of the grid: slabs along x, y and z (16 bins each; with
+// N > 16 adjacent slabs share a bin) and a coarse 4³ block grid. Counts saturate at 255, which keeps
+// |a − b| ≤ the true difference, so the bounds stay valid.
+CountProfile countProfile(const std::uint64_t* bits, int n) {
+  std::array<int, 48> slabs{};
+  std::array<int, 64> blocks{};
+  const int cells = n * n * n;
+  const auto bin = [n](int i, int bins) { return i * bins / std::max(n, bins); };
+  for (int w = 0; w * 64 < cells; ++w)
+    for (std::uint64_t word = bits[w]; word != 0; word &= word - 1) {
+      const int cell = w * 64 + std::countr_zero(word);
+      const int ijk[3] = {cell % n, cell / n % n, cell / (n * n)};
+      for (int axis = 0; axis < 3; ++axis)
+        ++slabs[static_cast<std::size_t>(axis * kProfileBins + bin(ijk[axis], kProfileBins))];
+      ++blocks[static_cast<std::size_t>(
+          bin(ijk[0], kBlocksPerAxis) +
+          kBlocksPerAxis * (bin(ijk[1], kBlocksPerAxis) + kBlocksPerAxis * bin(ijk[2], kBlocksPerAxis)))];
+    }
+  CountProfile out;
+  for (std::size_t i = 0; i < out.slabs.size(); ++i)
+    out.slabs[i] = static_cast<std::uint8_t>(std::min(slabs[i], 255));
+  for (std::size_t i = 0; i < out.blocks.size(); ++i)
+    out.blocks[i] = static_cast<std::uint8_t>(std::min(blocks[i], 255));
+  return out;
+}
+
+// Σ |a[i] − b[i]| over N bytes (N a multiple of 16): psadbw where the target has SSE2.
+template <std::size_t N>
+std::uint32_t absoluteDifferenceSum(const std::uint8_t* a, const std::uint8_t* b) {
+  static_assert(N % 16 == 0);
+#if defined(__SSE2__)
+  __m128i sum = _mm_setzero_si128();
+  for (std::size_t i = 0; i < N; i += 16) {
+    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a + i));
+    const __m128i y = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i));
+    sum = _mm_add_epi64(sum, _mm_sad_epu8(x, y));
+  }
+  return static_cast<std::uint32_t>(_mm_cvtsi128_si32(sum) + _mm_extract_epi16(sum, 4));
+#else
+  std::uint32_t sum = 0;
+  for (std::size_t i = 0; i < N; ++i)
+    sum += static_cast<std::uint32_t>(std::abs(int{a[i]} - int{b[i]}));
+  return sum;
+#endif
+}
+
+// Eq. (5) from the exclusive count x and the total s = n_a + n_b: x / union, union = (s + x) / 2.
+// Written as 2x / (s + x) so that the bound (the same function of a smaller x) is ≤ it in floating point.
+inline double jaccard(std::uint32_t exclusive, std::uint32_t total) {
+  return total + exclusive == 0 ? 0.0 : 2.0 * exclusive / (static_cast<double>(total) + exclusive);
+}
+
+inline bool isGrid(DescriptorKind kind) {
+  return kind != DescriptorKind::kMoment;
+}
+
+}  // namespace
+
+std::uint16_t quantizeCentroid(const Vec3& centroid) {
+  std::uint16_t code = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int q =
+        std::clamp(static_cast<int>(std::floor(centroid[axis] * kQuantLevels)), 0, kQuantLevels - 1);
+    code = static_cast<std::uint16_t>(code | (q << (5 * axis)));
+  }
+  return code;
+}
+
+Vec3 dequantizeCentroid(std::uint16_t code) {
+  return Vec3((code & 31) + 0.5, ((code >> 5) & 31) + 0.5, ((code >> 10) & 31) + 0.5) / kQuantLevels;
+}
+
+const char* toString(SearchMethod method) {
+  switch (method) {
+    case SearchMethod::kBruteForce:
+      return "brute-force";
+    case SearchMethod::kPruned:
+      return "pruned";
+    case SearchMethod::kBuckets:
+      return "buckets";
+  }
+  return "unknown";
+}
+
+// The query, expanded for fast comparison: dense centroids indexed by cell.
+struct Index::Query {
+  int candidate = 0;
+  std::uint32_t count = 0;
+  std::vector<std::uint64_t> bits;
+  CountProfile profile;
+  std::vector<std::uint16_t> dense;
+  Vec3 moments = Vec3::Zero();
+};
+
+// The k best (distance, entry) pairs seen, sorted; an entry appears once, with its best candidate.
+class Index::TopK {
+ public:
+  explicit TopK(std::size_t k) : mK(k) { mItems.reserve(k + 1); }
+
+  /// Anything whose lower bound exceeds this cannot enter.
+  double threshold() const { return mItems.size() < mK ? kInfinity : mItems.back().distance; }
+
+  void push(double distance, EntryId id, int candidate) {
+    const auto before = [](const Match& a, const Match& b) {
+      return a.distance < b.distance || (a.distance == b.distance && a.entry < b.entry);
+    };
+    for (auto it = mItems.begin(); it != mItems.end(); ++it) {
+      if (it->entry != id) continue;
+      if (distance < it->distance || (distance == it->distance && candidate < it->candidate)) {
+        mItems.erase(it);
+        break;
+      }
+      return;
+    }
+    Match m;
+    m.entry = id;
+    m.distance = distance;
+    m.candidate = candidate;
+    if (mItems.size() == mK && !before(m, mItems.back())) return;
+    mItems.insert(std::upper_bound(mItems.begin(), mItems.end(), m, before), m);
+    if (mItems.size() > mK) mItems.pop_back();
+  }
+
+  void merge(const TopK& other) {
+    for (const Match& m : other.mItems)
+      push(m.distance, m.entry, m.candidate);
+  }
+
+  std::vector<Match>& items() { return mItems; }
+  std::size_t capacity() const { return mK; }
+
+ private:
+  std::size_t mK;
+  std::vector<Match> mItems;
+};
+
+Index::Index(const DescriptorOptions& options) : mOptions(options) {
+  const int n = options.gridSize;
+  mWords = isGrid(options.kind) ? static_cast<std::uint32_t>((n * n * n + 63) / 64) : 0;
+  mCentroidBegin.assign(1, 0);
+  if (isGrid(options.kind)) mBucketBegin.assign(static_cast<std::size_t>(n * n * n + 2), 0);
+}
+
+std::size_t Index::memoryBytes() const {
+  return mIds.size() * sizeof(EntryId) + mCounts.size() * sizeof(std::uint32_t) +
+         mBits.size() * sizeof(std::uint64_t) + mProfiles.size() * sizeof(CountProfile) +
+         mCentroidBegin.size() * sizeof(std::uint64_t) + mCentroids.size() * sizeof(std::uint16_t) +
+         mBucketBegin.size() * sizeof(std::uint32_t) + mMoments.size() * sizeof(Vec3) +
+         mNodes.size() * sizeof(Node);
+}
+
+Index::Query Index::prepare(const Descriptor& d, int candidate) const {
+  Query q;
+  q.candidate = candidate;
+  q.moments = d.moments;
+  if (!isGrid(mOptions.kind)) return q;
+  q.count = static_cast<std::uint32_t>(d.cells.size());
+  q.bits.assign(mWords, 0);
+  for (std::uint32_t cell : d.cells)
+    q.bits[cell / 64] |= std::uint64_t{1} << (cell % 64);
+  q.profile = countProfile(q.bits.data(), mOptions.gridSize);
+  if (mOptions.kind == DescriptorKind::kCentroidVoxel) {
+    q.dense.assign(static_cast<std::size_t>(mWords) * 64, 0);
+    for (std::size_t i = 0; i < d.cells.size(); ++i)
+      q.dense[d.cells[i]] = quantizeCentroid(d.centroids[i]);
+  }
+  return q;
+}
+
+// Eq. (5) or (6) between the query and the entry in `slot`, on quantized centroids. Stops early, with
+// a partial value that already exceeds `threshold`, once the entry cannot be closer than it: the
+// partial sums only grow, and the same arithmetic on a larger sum never gives a smaller result.
+double Index::gridDistance(const Query& q, std::size_t slot, double threshold) const {
+  const std::uint64_t* bits = &mBits[slot * mWords];
+  std::uint32_t exclusive = 0;
+  for (std::uint32_t w = 0; w < mWords; ++w)
+    exclusive += static_cast<std::uint32_t>(std::popcount(bits[w] ^ q.bits[w]));
+  const std::uint32_t total = mCounts[slot] + q.count;
+  if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(exclusive, total);
+  if (total == 0) return 0.0;
+
+  // Eq. (6): walk the cells filled in both; an entry's centroids are stored in cell order, so a
+  // cell's centroid is at the rank of its bit among the entry's bits.
+  const auto value = [&](std::uint64_t terms) {
+    return (static_cast<double>(exclusive) + static_cast<double>(terms) * kTermUnit) / total;
+  };
+  const auto& table = centroidDistanceTable();
+  const std::uint16_t* centroids = &mCentroids[mCentroidBegin[slot]];
+  std::uint64_t terms = 0;
+  std::uint32_t rank = 0;
+  for (std::uint32_t w = 0; w < mWords; ++w) {
+    const std::uint64_t entryWord = bits[w];
+    const std::uint16_t* queryCodes = &q.dense[w * 64];
+    for (std::uint64_t both = entryWord & q.bits[w]; both != 0; both &= both - 1) {
+      const int bit = std::countr_zero(both);
+      const auto index =
+          rank + static_cast<std::uint32_t>(std::popcount(entryWord & ((std::uint64_t{1} << bit) - 1)));
+      terms += table[static_cast<std::size_t>(squaredCodeDistance(centroids[index], queryCodes[bit]))];
+    }
+    rank += static_cast<std::uint32_t>(std::popcount(entryWord));
+    if ((w & 3) == 3 && value(terms) > threshold) return value(terms);
+  }
+  return value(terms);
+}
+
+// A lower bound of gridDistance from counts alone: the cells filled in exactly one grid number at
+// least Σ |count_a − count_b| over the parts of any partition of the grid (slabs, blocks).
+double Index::gridBound(const Query& q, std::size_t slot) const {
+  const CountProfile& p = mProfiles[slot];
+  const std::uint8_t* a = p.slabs.data();
+  const std::uint8_t* b = q.profile.slabs.data();
+  std::uint32_t best = absoluteDifferenceSum<64>(p.blocks.data(), q.profile.blocks.data());
+  for (int axis = 0; axis < 3; ++axis)
+    best =
+        std::max(best, absoluteDifferenceSum<kProfileBins>(a + axis * kProfileBins, b + axis * kProfileBins));
+  const std::uint32_t count = mCounts[slot];
+  best = std::max(best, count > q.count ? count - q.count : q.count - count);
+  const std::uint32_t total = count + q.count;
+  if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(best, total);
+  return total == 0 ? 0.0 : static_cast<double>(best) / total;
+}
+
+// The bound for every entry with `count` filled cells: |count − n_q| cells are filled in one only.
+double Index::countBound(const Query& q, std::uint32_t count) const {
+  const std::uint32_t exclusive = count > q.count ? count - q.count : q.count - count;
+  const std::uint32_t total = count + q.count;
+  if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(exclusive, total);
+  return total == 0 ? 0.0 : static_cast<double>(exclusive) / total;
+}
+
+// Buckets of equal filled-cell count, visited outward from the query's count in order of their bound;
+// a side stops when its bound exceeds the k-th best distance (the bounds grow monotonically outward).
+// With `parallel`, once the nearest buckets have set a threshold, the buckets still within it are
+// scanned by TBB tasks that share the least of their k-th bests: each is an upper bound of the final
+// k-th best, so pruning against it stays exact, and merging the lists gives the same answer as one
+// thread.
+void Index::searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const {
+  const auto maxCount = static_cast<std::int64_t>(mBucketBegin.size()) - 2;
+  std::int64_t up = std::min<std::int64_t>(q.count, maxCount + 1), down = up - 1;
+  const auto bucket = [&](std::int64_t count) {
+    const auto c = static_cast<std::size_t>(count);
+    return std::pair<std::size_t, std::size_t>(mBucketBegin[c], mBucketBegin[c + 1]);
+  };
+  const auto scan = [&](std::size_t begin, std::size_t end, TopK& local, SearchStats& st, double shared) {
+    for (std::size_t slot = begin; slot < end; ++slot) {
+      ++st.boundEvaluations;
+      const double threshold = std::min(shared, local.threshold());
+      if (gridBound(q, slot) > threshold) continue;
+      ++st.distanceEvaluations;
+      local.push(gridDistance(q, slot, threshold), mIds[slot], q.candidate);
+    }
+  };
+  // The next bucket in bound order, or -1 when no bucket left can hold a match.
+  const auto next = [&](double threshold) -> std::int64_t {
+    const double upBound = up <= maxCount ? countBound(q, static_cast<std::uint32_t>(up)) : kInfinity;
+    const double downBound = down >= 0 ? countBound(q, static_cast<std::uint32_t>(down)) : kInfinity;
+    if (std::min(upBound, downBound) == kInfinity || std::min(upBound, downBound) > threshold) return -1;
+    return upBound <= downBound ? up++ : down--;
+  };
+
+  constexpr std::size_t kSequentialSlots = 8192;
+  std::size_t scanned = 0;
+  for (std::int64_t c = next(top.threshold()); c >= 0; c = next(top.threshold())) {
+    const auto [begin, end] = bucket(c);
+    scan(begin, end, top, stats, kInfinity);
+    scanned += end - begin;
+    if (parallel && scanned >= kSequentialSlots) break;
+  }
+  if (!parallel || scanned < kSequentialSlots) return;
+
+  // The buckets left within the threshold, scanned in parallel.
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  for (std::int64_t c = next(top.threshold()); c >= 0; c = next(top.threshold()))
+    if (bucket(c).second > bucket(c).first) ranges.push_back(bucket(c));
+  if (ranges.empty()) return;
+  std::atomic<double> shared{top.threshold()};
+  struct Part {
+    TopK top;
+    SearchStats stats;
+  };
+  const std::size_t k = top.capacity();
+  const Part found = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, ranges.size(), 1), Part{TopK(k), {}},
+      [&](const tbb::blocked_range<std::size_t>& r, Part part) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          scan(ranges[i].first, ranges[i].second, part.top, part.stats,
+               shared.load(std::memory_order_relaxed));
+          // Publish this task's k-th best if it lowers the shared threshold.
+          double seen = shared.load(std::memory_order_relaxed);
+          const double mine = part.top.threshold();
+          while (mine < seen && !shared.compare_exchange_weak(seen, mine, std::memory_order_relaxed)) {
+          }
+        }
+        return part;
+      },
+      [](Part a, const Part& b) {
+        a.top.merge(b.top);
+        a.stats.boundEvaluations += b.stats.boundEvaluations;
+        a.stats.distanceEvaluations += b.stats.distanceEvaluations;
+        return a;
+      });
+  top.merge(found.top);
+  stats.boundEvaluations += found.stats.boundEvaluations;
+  stats.distanceEvaluations += found.stats.distanceEvaluations;
+}
+
+// Paper §5: only the entries whose filled-cell count is within ±r of the query's, all compared.
+void Index::searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const {
+  const auto maxCount = static_cast<std::int64_t>(mBucketBegin.size()) - 2;
+  const std::int64_t first = std::max<std::int64_t>(0, static_cast<std::int64_t>(q.count) - radius);
+  const std::int64_t last = std::min<std::int64_t>(maxCount, static_cast<std::int64_t>(q.count) + radius);
+  for (std::int64_t c = first; c <= last; ++c)
+    for (std::size_t slot = mBucketBegin[static_cast<std::size_t>(c)];
+         slot < mBucketBegin[static_cast<std::size_t>(c) + 1]; ++slot) {
+      ++stats.distanceEvaluations;
+      top.push(gridDistance(q, slot, kInfinity), mIds[slot], q.candidate);
+    }
+}
+
+// Nearest moments in the k-d tree: the nearer child first, the farther one only if the squared
+// distance to its splitting plane does not exceed the k-th best.
+void Index::searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const {
+  if (mNodes.empty()) return;
+  std::int32_t stack[128];
+  int depth = 0;
+  stack[depth++] = 0;
+  while (depth > 0) {
+    const Node& node = mNodes[static_cast<std::size_t>(stack[--depth])];
+    ++stats.boundEvaluations;
+    if (node.left < 0) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        ++stats.distanceEvaluations;
+        top.push(momentDistance(q, mMoments[i]), mIds[i], candidate);
+      }
+      continue;
+    }
+    const double diff = q[node.axis] - node.split;
+    const std::int32_t nearChild = diff < 0.0 ? node.left : node.right;
+    const std::int32_t farChild = diff < 0.0 ? node.right : node.left;
+    // Depth-first: push the far child first (visited later), after checking it can still matter.
+    if (diff * diff <= top.threshold()) stack[depth++] = farChild;
+    stack[depth++] = nearChild;
+  }
+}
+
+Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates, const SearchOptions& options,
+                                         SearchStats* stats) const {
+  if (candidates.empty())
+    return Error{ErrorCode::kInvalidArgument, "search needs at least one query descriptor"};
+  if (options.k < 1) return Error{ErrorCode::kInvalidArgument, "k must be at least 1"};
+  for (const Descriptor& d : candidates) {
+    if (d.kind != mOptions.kind)
+      return Error{ErrorCode::kInvalidArgument, std::string("query descriptor is ") + toString(d.kind) +
+                                                    ", the index holds " + toString(mOptions.kind)};
+    if (isGrid(d.kind) && (d.gridSize != mOptions.gridSize || d.sampling != mOptions.sampling))
+      return Error{ErrorCode::kInvalidArgument,
+                   "query descriptor has grid " + std::to_string(d.gridSize) + " with " +
+                       toString(d.sampling) + " sampling, the index " + std::to_string(mOptions.gridSize) +
+                       " with " + toString(mOptions.sampling)};
+  }
+  SearchStats local;
+  SearchStats& st = stats ? *stats : local;
+  const auto k = static_cast<std::size_t>(options.k);
+  std::vector<Query> queries;
+  queries.reserve(candidates.size());
+  for (std::size_t c = 0; c < candidates.size(); ++c)
+    queries.push_back(prepare(candidates[c], static_cast<int>(c)));
+
+  TopK top(k);
+  const bool grid = isGrid(mOptions.kind);
+  if (options.method == SearchMethod::kBruteForce) {
+    // The oracle: every entry, its least distance over the candidates.
+    const auto scan = [&](const tbb::blocked_range<std::size_t>& range, TopK part) {
+      for (std::size_t slot = range.begin(); slot != range.end(); ++slot)
+        for (const Query& q : queries) {
+          const double d =
+              grid ? gridDistance(q, slot, kInfinity) : momentDistance(q.moments, mMoments[slot]);
+          part.push(d, mIds[slot], q.candidate);
+        }
+      return part;
+    };
+    const tbb::blocked_range<std::size_t> all(0, size(), 1024);
+    if (options.parallel) {
+      top = tbb::parallel_reduce(all, TopK(k), scan, [](TopK a, const TopK& b) {
+        a.merge(b);
+        return a;
+      });
+    } else {
+      top = scan(all, TopK(k));
+    }
+    st.distanceEvaluations += size() * queries.size();
+  } else {
+    // One shared k-best across candidates: pruning against it is safe, since the final k-th best
+    // can only be smaller.
+    for (const Query& q : queries) {
+      if (!grid) {
+        searchMomentTree(q.moments, q.candidate, top, st);
+      } else if (options.method == SearchMethod::kPruned) {
+        searchGridPruned(q, top, st, options.parallel);
+      } else {
+        searchGridBuckets(q, options.bucketRadius, top, st);
+      }
+    }
+  }
+  std::vector<Match> out = std::move(top.items());
+  for (Match& m : out)
+    m.orientation = candidates[static_cast<std::size_t>(m.candidate)].orientation;
+  return out;
+}
+
+IndexBuilder::IndexBuilder(const DescriptorOptions& options) : mOptions(options) {
+  const int n = options.gridSize;
+  mWords = isGrid(options.kind) ? static_cast<std::uint32_t>((n * n * n + 63) / 64) : 0;
+}
+
+Status IndexBuilder::add(EntryId id, const Descriptor& d) {
+  if (d.kind != mOptions.kind ||
+      (isGrid(d.kind) && (d.gridSize != mOptions.gridSize || d.sampling != mOptions.sampling)))
+    return Error{
+        ErrorCode::kInvalidArgument,
+        "entry " + std::to_string(id) + ": descriptor of another kind, grid or sampling than the index"};
+  mIds.push_back(id);
+  if (!isGrid(d.kind)) {
+    mMoments.push_back(d.moments);
+    return Ok{};
+  }
+  mCounts.push_back(static_cast<std::uint32_t>(d.cells.size()));
+  const std::size_t base = mBits.size();
+  mBits.resize(base + mWords, 0);
+  for (std::uint32_t cell : d.cells)
+    mBits[base + cell / 64] |= std::uint64_t{1} << (cell % 64);
+  if (mOptions.kind == DescriptorKind::kCentroidVoxel)
+    for (const Vec3& c : d.centroids)
+      mCentroids.push_back(quantizeCentroid(c));
+  mCentroidBegin.push_back(mCentroids.size());
+  return Ok{};
+}
+
+Result<Index> IndexBuilder::build() && {
+  Index index(mOptions);
+  const std::size_t count = mIds.size();
+  {
+    std::vector<EntryId> sorted = mIds;
+    std::sort(sorted.begin(), sorted.end());
+    if (auto dup = std::adjacent_find(sorted.begin(), sorted.end()); dup != sorted.end())
+      return Error{ErrorCode::kInvalidArgument, "entry " + std::to_string(*dup) + " added twice"};
+  }
+  std::vector<std::size_t> order(count);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+
+  if (!isGrid(mOptions.kind)) {
+    // k-d tree: split the widest axis at the median, (value, id) ordered for determinism.
+    index.mIds = mIds;
+    index.mMoments = mMoments;
+    if (count == 0) return index;
+    struct Range {
+      std::uint32_t begin, end;
+      std::int32_t node;
+    };
+    index.mNodes.push_back({0, static_cast<std::uint32_t>(count)});
+    std::vector<Range> work = {{0, static_cast<std::uint32_t>(count), 0}};
+    std::vector<std::pair<Vec3, EntryId>> points(count);
+    for (std::size_t i = 0; i < count; ++i)
+      points[i] = {mMoments[i], mIds[i]};
+    while (!work.empty()) {
+      const Range r = work.back();
+      work.pop_back();
+      if (r.end - r.begin <= kLeafSize) continue;
+      Vec3 lo = Vec3::Constant(kInfinity), hi = -lo;
+      for (std::uint32_t i = r.begin; i < r.end; ++i) {
+        lo = lo.cwiseMin(points[i].first);
+        hi = hi.cwiseMax(points[i].first);
+      }
+      int axis = 0;
+      (hi - lo).maxCoeff(&axis);
+      const std::uint32_t mid = r.begin + (r.end - r.begin) / 2;
+      std::nth_element(points.begin() + r.begin, points.begin() + mid, points.begin() + r.end,
+                       [axis](const auto& a, const auto& b) {
+                         return a.first[axis] < b.first[axis] ||
+                                (a.first[axis] == b.first[axis] && a.second < b.second);
+                       });
+      const auto left = static_cast<std::int32_t>(index.mNodes.size());
+      index.mNodes.push_back({r.begin, mid});
+      index.mNodes.push_back({mid, r.end});
+      Index::Node& node = index.mNodes[static_cast<std::size_t>(r.node)];
+      node.left = left;
+      node.right = left + 1;
+      node.axis = axis;
+      node.split = points[mid].first[axis];
+      work.push_back({r.begin, mid, left});
+      work.push_back({mid, r.end, left + 1});
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      index.mMoments[i] = points[i].first;
+      index.mIds[i] = points[i].second;
+    }
+    return index;
+  }
+
+  // Voxel kinds: slots sorted by (filled count, id); buckets of equal count.
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return mCounts[a] < mCounts[b] || (mCounts[a] == mCounts[b] && mIds[a] < mIds[b]);
+  });
+  index.mIds.resize(count);
+  index.mCounts.resize(count);
+  index.mBits.resize(count * mWords);
+  index.mProfiles.resize(count);
+  index.mCentroidBegin.assign(count + 1, 0);
+  index.mCentroids.reserve(mCentroids.size());
+  for (std::size_t slot = 0; slot < count; ++slot) {
+    const std::size_t i = order[slot];
+    index.mIds[slot] = mIds[i];
+    index.mCounts[slot] = mCounts[i];
+    std::copy_n(&mBits[i * mWords], mWords, &index.mBits[slot * mWords]);
+    index.mProfiles[slot] = countProfile(&mBits[i * mWords], mOptions.gridSize);
+    index.mCentroids.insert(index.mCentroids.end(),
+                            mCentroids.begin() + static_cast<std::ptrdiff_t>(mCentroidBegin[i]),
+                            mCentroids.begin() + static_cast<std::ptrdiff_t>(mCentroidBegin[i + 1]));
+    index.mCentroidBegin[slot + 1] = index.mCentroids.size();
+  }
+  for (std::size_t slot = 0; slot < count; ++slot)
+    ++index.mBucketBegin[index.mCounts[slot] + 1];
+  for (std::size_t c = 1; c < index.mBucketBegin.size(); ++c)
+    index.mBucketBegin[c] += index.mBucketBegin[c - 1];
+  return index;
+}
+
+}  // namespace shapedb::core

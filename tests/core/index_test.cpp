@@ -1,0 +1,245 @@
+#include <iostream>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/index.h>
+
+#include "support/synthetic.h"
+#include "support/test_support.h"
+
+namespace shapedb::core {
+namespace {
+
+DescriptorOptions optionsFor(DescriptorKind kind) {
+  DescriptorOptions o;
+  o.kind = kind;
+  return o;
+}
+
+// Descriptors of `count` random shapes, the bases that jittered entries and queries are made from.
+std::vector<Descriptor> baseDescriptors(DescriptorKind kind, int count, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<Descriptor> out;
+  while (static_cast<int>(out.size()) < count) {
+    Result<test::DescribedMesh> d = test::describeMesh(test::makeRandomShape(rng, 2), optionsFor(kind));
+    if (d) out.push_back(d->descriptor);
+  }
+  return out;
+}
+
+Index buildIndex(DescriptorKind kind, const std::vector<Descriptor>& entries) {
+  IndexBuilder builder(optionsFor(kind));
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    EXPECT_TRUE(builder.add(static_cast<EntryId>(1000 + 7 * i), entries[i]).ok());
+  Result<Index> index = std::move(builder).build();
+  EXPECT_TRUE(index.ok());
+  return std::move(index).value();
+}
+
+std::vector<Match> searchOrDie(const Index& index, std::span<const Descriptor> query, SearchOptions options,
+                               SearchStats* stats = nullptr) {
+  Result<std::vector<Match>> r = index.search(query, options, stats);
+  EXPECT_TRUE(r.ok()) << (r ? "" : r.error().message);
+  return r ? std::move(r).value() : std::vector<Match>{};
+}
+
+void expectSameMatches(const std::vector<Match>& a, const std::vector<Match>& b, const std::string& where) {
+  ASSERT_EQ(a.size(), b.size()) << where;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].entry, b[i].entry) << where << " rank " << i;
+    EXPECT_EQ(a[i].distance, b[i].distance) << where << " rank " << i;
+    EXPECT_EQ(a[i].candidate, b[i].candidate) << where << " rank " << i;
+  }
+}
+
+// Pruned search against brute force: `queries` random queries against `entryCount` jittered entries,
+// with k from 1 to 10 and one to three orientation candidates per query.
+void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queries) {
+  const std::vector<Descriptor> bases = baseDescriptors(kind, 150, 42);
+  std::mt19937_64 rng(99);
+  std::uniform_int_distribution<int> flips(0, 10), pickBase(0, 149), pickK(1, 10), pickCandidates(1, 3);
+  std::vector<Descriptor> entries;
+  for (int i = 0; i < entryCount; ++i)
+    entries.push_back(
+        test::jitterDescriptor(bases[static_cast<std::size_t>(i % 150)], rng, flips(rng), 0.15));
+  const Index index = buildIndex(kind, entries);
+  ASSERT_EQ(index.size(), static_cast<std::size_t>(entryCount));
+
+  SearchStats pruned, brute;
+  for (int q = 0; q < queries; ++q) {
+    std::vector<Descriptor> candidates;
+    const Descriptor& base = bases[static_cast<std::size_t>(pickBase(rng))];
+    for (int c = pickCandidates(rng); c > 0; --c)
+      candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
+    SearchOptions options;
+    options.k = pickK(rng);
+    options.method = SearchMethod::kBruteForce;
+    const std::vector<Match> expected = searchOrDie(index, candidates, options, &brute);
+    options.method = SearchMethod::kPruned;
+    expectSameMatches(searchOrDie(index, candidates, options, &pruned), expected,
+                      "query " + std::to_string(q));
+    options.parallel = false;
+    expectSameMatches(searchOrDie(index, candidates, options), expected,
+                      "query " + std::to_string(q) + ", one thread");
+    if (::testing::Test::HasFailure()) break;
+  }
+  std::cout << "  " << toString(kind) << ": pruned search computed " << pruned.distanceEvaluations
+            << " distances, " << pruned.boundEvaluations << " bounds; brute force "
+            << brute.distanceEvaluations << " distances\n";
+  EXPECT_LT(pruned.distanceEvaluations, brute.distanceEvaluations / 4);
+}
+
+class IndexAtScale : public ::testing::TestWithParam<DescriptorKind> {};
+class IndexSmall : public ::testing::TestWithParam<DescriptorKind> {};
+
+// The must-show: 10,000 random queries against 20,000 entries (release builds; the sanitizer preset
+// runs IndexSmall).
+TEST_P(IndexAtScale, PrunedEqualsBruteForce) {
+  expectPrunedEqualsBruteForce(GetParam(), 20000, 10000);
+}
+TEST_P(IndexSmall, PrunedEqualsBruteForce) {
+  expectPrunedEqualsBruteForce(GetParam(), 2000, 300);
+}
+
+const auto kKinds =
+    ::testing::Values(DescriptorKind::kMoment, DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel);
+std::string kindName(const ::testing::TestParamInfo<DescriptorKind>& param) {
+  return param.param == DescriptorKind::kMoment  ? "Moment"
+         : param.param == DescriptorKind::kVoxel ? "Voxel"
+                                                 : "CentroidVoxel";
+}
+INSTANTIATE_TEST_SUITE_P(Descriptors, IndexSmall, kKinds, kindName);
+INSTANTIATE_TEST_SUITE_P(Descriptors, IndexAtScale, kKinds, kindName);
+
+TEST(Index, BruteForceGivesTheSameAnswerOnOneAndManyThreads) {
+  const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kCentroidVoxel, 20, 3);
+  std::mt19937_64 rng(4);
+  std::vector<Descriptor> entries;
+  for (int i = 0; i < 5000; ++i)
+    entries.push_back(test::jitterDescriptor(bases[static_cast<std::size_t>(i % 20)], rng, 3, 0.1));
+  const Index index = buildIndex(DescriptorKind::kCentroidVoxel, entries);
+  for (int q = 0; q < 20; ++q) {
+    const Descriptor query = test::jitterDescriptor(bases[static_cast<std::size_t>(q)], rng, 4, 0.1);
+    SearchOptions options;
+    options.k = 8;
+    options.method = SearchMethod::kBruteForce;
+    options.parallel = false;
+    const std::vector<Match> serial = searchOrDie(index, std::span(&query, 1), options);
+    options.parallel = true;
+    expectSameMatches(searchOrDie(index, std::span(&query, 1), options), serial,
+                      "query " + std::to_string(q));
+  }
+}
+
+TEST(Index, QuantizedDistanceStaysWithinACentroidStepOfTheExactOne) {
+  const std::vector<Descriptor> entries = baseDescriptors(DescriptorKind::kCentroidVoxel, 60, 8);
+  const Index index = buildIndex(DescriptorKind::kCentroidVoxel, entries);
+  SearchOptions all;
+  all.k = static_cast<int>(entries.size());
+  all.method = SearchMethod::kBruteForce;
+  for (std::size_t q = 0; q < 10; ++q) {
+    const std::vector<Match> matches = searchOrDie(index, std::span(&entries[q], 1), all);
+    ASSERT_EQ(matches.size(), entries.size());
+    for (const Match& m : matches) {
+      const double exact = centroidVoxelDistance(entries[q], entries[(m.entry - 1000) / 7]);
+      // Each quantized coordinate moves by ≤ 1/64 cell, so each centroid term by ≤ 2 · (√3/64) / √3.
+      EXPECT_NEAR(m.distance, exact, 1.0 / 32.0 + 1e-6);
+    }
+    EXPECT_EQ(matches.front().entry, 1000 + 7 * q);
+    EXPECT_LT(matches.front().distance, 1.0 / 64.0);
+  }
+}
+
+TEST(Index, TiesBreakByEntryId) {
+  const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kVoxel, 1, 12);
+  IndexBuilder builder(optionsFor(DescriptorKind::kVoxel));
+  for (EntryId id : {50u, 7u, 31u, 2u, 19u})
+    ASSERT_TRUE(builder.add(id, bases[0]).ok());
+  Result<Index> index = std::move(builder).build();
+  ASSERT_TRUE(index.ok());
+  for (SearchMethod method : {SearchMethod::kBruteForce, SearchMethod::kPruned, SearchMethod::kBuckets}) {
+    SearchOptions options;
+    options.k = 3;
+    options.method = method;
+    const std::vector<Match> m = searchOrDie(*index, std::span(&bases[0], 1), options);
+    ASSERT_EQ(m.size(), 3u);
+    EXPECT_EQ(m[0].entry, 2u);
+    EXPECT_EQ(m[1].entry, 7u);
+    EXPECT_EQ(m[2].entry, 19u);
+  }
+}
+
+TEST(Index, PaperBucketsMissWhatTheExactSearchFinds) {
+  const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kCentroidVoxel, 100, 21);
+  std::mt19937_64 rng(22);
+  std::vector<Descriptor> entries;
+  for (int i = 0; i < 3000; ++i)
+    entries.push_back(test::jitterDescriptor(bases[static_cast<std::size_t>(i % 100)], rng, 6, 0.15));
+  const Index index = buildIndex(DescriptorKind::kCentroidVoxel, entries);
+  std::map<int, int> misses;
+  const int queries = 300;
+  for (int q = 0; q < queries; ++q) {
+    const Descriptor query = test::jitterDescriptor(bases[static_cast<std::size_t>(q % 100)], rng, 20, 0.2);
+    SearchOptions options;
+    const EntryId exact = searchOrDie(index, std::span(&query, 1), options).front().entry;
+    options.method = SearchMethod::kBuckets;
+    for (int r : {0, 2, 6, 1000}) {
+      options.bucketRadius = r;
+      const std::vector<Match> m = searchOrDie(index, std::span(&query, 1), options);
+      if (m.empty() || m.front().entry != exact) ++misses[r];
+    }
+  }
+  for (int r : {0, 2, 6})
+    std::cout << "  buckets ±" << r << ": top-1 missed on " << misses[r] << " of " << queries << " queries\n";
+  EXPECT_EQ(misses[1000], 0);  // a radius covering every count is a full scan
+  EXPECT_GT(misses[0], 0);
+  EXPECT_GE(misses[0], misses[2]);
+  EXPECT_GE(misses[2], misses[6]);
+}
+
+TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
+  const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kVoxel, 2, 30);
+  const Index index = buildIndex(DescriptorKind::kVoxel, bases);
+  Descriptor other = bases[0];
+  other.kind = DescriptorKind::kCentroidVoxel;
+  EXPECT_EQ(index.search(other).error().code, ErrorCode::kInvalidArgument);
+  other = bases[0];
+  other.gridSize = 12;
+  EXPECT_EQ(index.search(other).error().code, ErrorCode::kInvalidArgument);
+  other = bases[0];
+  other.sampling = Sampling::kVertices;
+  EXPECT_EQ(index.search(other).error().code, ErrorCode::kInvalidArgument);
+  SearchOptions zero;
+  zero.k = 0;
+  EXPECT_EQ(index.search(bases[0], zero).error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(index.search(std::span<const Descriptor>()).error().code, ErrorCode::kInvalidArgument);
+
+  IndexBuilder builder(optionsFor(DescriptorKind::kVoxel));
+  ASSERT_TRUE(builder.add(4, bases[0]).ok());
+  ASSERT_TRUE(builder.add(4, bases[1]).ok());
+  Result<Index> dup = std::move(builder).build();
+  ASSERT_FALSE(dup.ok());
+  EXPECT_NE(dup.error().message.find("entry 4 added twice"), std::string::npos);
+}
+
+TEST(Index, EmptyIndexFindsNothingAndSmallIndexReturnsEverything) {
+  const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kMoment, 3, 31);
+  for (DescriptorKind kind : {DescriptorKind::kMoment, DescriptorKind::kVoxel}) {
+    const Index empty(optionsFor(kind));
+    Descriptor q = bases[0];
+    q.kind = kind;
+    if (kind == DescriptorKind::kVoxel) q.gridSize = 10;
+    Result<std::vector<Match>> none = empty.search(q);
+    ASSERT_TRUE(none.ok());
+    EXPECT_TRUE(none->empty());
+  }
+  const Index index = buildIndex(DescriptorKind::kMoment, bases);
+  SearchOptions options;
+  options.k = 10;
+  EXPECT_EQ(searchOrDie(index, std::span(&bases[1], 1), options).size(), 3u);
+}
+
+}  // namespace
+}  // namespace shapedb::core

@@ -1,0 +1,208 @@
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/index.h>
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/normalize.h>
+#include <shapedb/core/primitives.h>
+#include <shapedb/volume/describe.h>
+
+#include "support/synthetic.h"
+#include "support/test_support.h"
+
+namespace shapedb::volume {
+namespace {
+
+using core::Descriptor;
+using core::DescriptorKind;
+using core::DescriptorOptions;
+using core::Sampling;
+using core::TriangleMesh;
+using core::Vec3;
+
+DescriptorOptions optionsFor(DescriptorKind kind, Sampling sampling, int grid = 10) {
+  DescriptorOptions o;
+  o.kind = kind;
+  o.sampling = sampling;
+  o.gridSize = grid;
+  return o;
+}
+
+Descriptor describeOrDie(const TriangleMesh& mesh, const DescriptorOptions& options) {
+  Result<test::DescribedMesh> d = test::describeMesh(mesh, options);
+  EXPECT_TRUE(d.ok()) << (d ? "" : d.error().message);
+  return d ? d->descriptor : Descriptor{};
+}
+
+TEST(Describe, BoxWithFacesOnCellPlanesFillsExactlyItsCells) {
+  // A 3 × 2 × 1 box on a 6-grid: side 3 units, cells of 0.5, faces at y = ±1 and z = ±0.5 lie on
+  // cell planes; the box covers x cells 0–5, y 1–4, z 2–3, every one of them touching a face.
+  const TriangleMesh box = core::makeBox(Vec3(3.0, 2.0, 1.0));
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    const TriangleMesh mesh = trial == 0 ? box : core::transformed(box, test::randomSimilarity(rng));
+    const Descriptor d = describeOrDie(mesh, optionsFor(DescriptorKind::kCentroidVoxel, Sampling::kArea, 6));
+    std::vector<std::uint32_t> expected;
+    for (int k = 2; k <= 3; ++k)
+      for (int j = 1; j <= 4; ++j)
+        for (int i = 0; i <= 5; ++i)
+          expected.push_back(static_cast<std::uint32_t>(i + 6 * (j + 6 * k)));
+    ASSERT_EQ(d.cells, expected) << "trial " << trial;
+
+    // The weights are the area of the unit-volume box; the surface's centroid is the origin.
+    const double unit = std::cbrt(6.0);
+    double area = 0.0;
+    Vec3 moment = Vec3::Zero();
+    for (std::size_t c = 0; c < d.cells.size(); ++c) {
+      area += d.weights[c];
+      moment += d.weights[c] * d.canonicalCentroid(c);
+      EXPECT_TRUE((d.centroids[c].array() >= 0.0).all() && (d.centroids[c].array() <= 1.0).all());
+    }
+    EXPECT_NEAR(area, 22.0 / (unit * unit), 1e-12);
+    EXPECT_LT(moment.norm(), 1e-12);
+  }
+}
+
+TEST(Describe, VertexSamplingBinsTheVerticesAsThePaperDoes) {
+  const TriangleMesh mesh = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 2);
+  const Descriptor d = describeOrDie(mesh, optionsFor(DescriptorKind::kVoxel, Sampling::kVertices));
+  double count = 0.0;
+  for (double w : d.weights)
+    count += w;
+  EXPECT_EQ(count, static_cast<double>(mesh.vertices.size()));
+  EXPECT_LE(d.cells.size(), mesh.vertices.size());
+}
+
+TEST(Describe, MomentDescriptorIsTheCanonicalMoments) {
+  const TriangleMesh mesh = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 2);
+  Result<test::DescribedMesh> d =
+      test::describeMesh(mesh, optionsFor(DescriptorKind::kMoment, Sampling::kArea));
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d->descriptor.moments, d->normalization.canonicalMoments);
+  EXPECT_TRUE(d->descriptor.cells.empty());
+}
+
+TEST(Describe, RejectsOptionsOutOfRange) {
+  const TriangleMesh mesh = core::makeBox(Vec3(1, 2, 3));
+  for (int grid : {0, 1, core::kMaxGridSize + 1}) {
+    Result<test::DescribedMesh> d =
+        test::describeMesh(mesh, optionsFor(DescriptorKind::kVoxel, Sampling::kArea, grid));
+    ASSERT_FALSE(d.ok());
+    EXPECT_EQ(d.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(d.error().message.find("grid size"), std::string::npos);
+  }
+}
+
+// The must-show invariance: 1,000 random rigid transforms and scales, the same descriptor, and the
+// shape finds itself first among others.
+TEST(Describe, SameDescriptorAndSelfMatchUnderThousandRandomSimilarities) {
+  const TriangleMesh shape = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 3);
+  std::mt19937_64 shapes(11);
+  std::vector<TriangleMesh> others;
+  for (int i = 0; i < 300; ++i)
+    others.push_back(test::makeRandomShape(shapes, 2));
+
+  for (Sampling sampling : {Sampling::kArea, Sampling::kVertices}) {
+    for (DescriptorKind kind :
+         {DescriptorKind::kMoment, DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
+      SCOPED_TRACE(std::string(core::toString(kind)) + " / " + core::toString(sampling));
+      const DescriptorOptions options = optionsFor(kind, sampling);
+      const Descriptor reference = describeOrDie(shape, options);
+      core::IndexBuilder builder(options);
+      ASSERT_TRUE(builder.add(0, reference).ok());
+      for (std::size_t i = 0; i < others.size(); ++i)
+        ASSERT_TRUE(builder.add(static_cast<core::EntryId>(i + 1), describeOrDie(others[i], options)).ok());
+      Result<core::Index> index = std::move(builder).build();
+      ASSERT_TRUE(index.ok());
+
+      std::mt19937_64 rng(2024);
+      int differentCells = 0;
+      double worstMoment = 0.0, worstCentroid = 0.0;
+      for (int trial = 0; trial < 1000; ++trial) {
+        const Descriptor d = describeOrDie(core::transformed(shape, test::randomSimilarity(rng)), options);
+        worstMoment = std::max(
+            worstMoment,
+            ((d.moments - reference.moments).cwiseAbs().array() / reference.moments.array()).maxCoeff());
+        if (d.cells != reference.cells) {
+          ++differentCells;
+        } else {
+          for (std::size_t c = 0; c < d.cells.size(); ++c)
+            worstCentroid =
+                std::max(worstCentroid, (d.centroids[c] - reference.centroids[c]).cwiseAbs().maxCoeff());
+        }
+        Result<std::vector<core::Match>> top = index->search(d);
+        ASSERT_TRUE(top.ok());
+        ASSERT_EQ(top->size(), 1u);
+        EXPECT_EQ(top->front().entry, 0u) << "trial " << trial << ": matched " << top->front().entry;
+      }
+      EXPECT_LT(worstMoment, 1e-9);
+      EXPECT_EQ(differentCells, 0);
+      EXPECT_LT(worstCentroid, 1e-6);
+    }
+  }
+}
+
+// Area sampling sees the surface, not its tessellation; vertex sampling sees the vertices.
+TEST(Describe, AreaSamplingIgnoresTessellationVertexSamplingDoesNot) {
+  const TriangleMesh mesh = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 3);     // 1,280 triangles
+  const TriangleMesh finer = core::subdivideMidpoint(mesh);                     // the same surface, 5,120
+  const TriangleMesh coarser = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 2);  // 320, a coarser surface
+  std::map<std::string, double> figures;
+  for (Sampling sampling : {Sampling::kArea, Sampling::kVertices})
+    for (DescriptorKind kind : {DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
+      const DescriptorOptions options = optionsFor(kind, sampling);
+      const Descriptor base = describeOrDie(mesh, options);
+      const std::string key = std::string(core::toString(kind)) + "/" + core::toString(sampling);
+      figures[key + " finer"] = core::descriptorDistance(base, describeOrDie(finer, options));
+      figures[key + " coarser"] = core::descriptorDistance(base, describeOrDie(coarser, options));
+    }
+  for (const auto& [name, value] : figures) {
+    std::cout << "  distance " << name << ": " << value << "\n";
+    RecordProperty(name, std::to_string(value));
+  }
+  for (const char* kind : {"voxel", "centroid-voxel"}) {
+    const std::string k = kind;
+    EXPECT_LT(figures[k + "/area finer"], 1e-6);
+    EXPECT_LT(figures[k + "/area coarser"], 0.1);
+    EXPECT_GT(figures[k + "/vertices finer"], 10.0 * figures[k + "/area finer"] + 0.05);
+    EXPECT_GT(figures[k + "/vertices coarser"], figures[k + "/area coarser"]);
+  }
+}
+
+// A square-section bar has two equal moments: its canonical frame turns freely about x, and only the
+// orientation candidates find it again.
+TEST(Describe, OrientationCandidatesRecoverAFrameTurnedInADegeneratePlane) {
+  const TriangleMesh bar = core::makeBox(Vec3(3.0, 1.0, 1.0));
+  const DescriptorOptions options = optionsFor(DescriptorKind::kCentroidVoxel, Sampling::kArea);
+  const Descriptor reference = describeOrDie(bar, options);
+  std::mt19937_64 rng(5);
+  double worstCanonical = 0.0, worstBest = 0.0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const TriangleMesh mesh = core::transformed(bar, test::randomSimilarity(rng));
+    Result<core::MassProperties> mp = core::computeMassProperties(mesh);
+    ASSERT_TRUE(mp.ok());
+    Result<core::Normalization> n = core::normalize(mesh, *mp);
+    ASSERT_TRUE(n.ok());
+    ASSERT_EQ(n->degeneracy, core::AxisDegeneracy::kYZ);
+    Describer describer(options);
+    Result<std::vector<Descriptor>> candidates = describer.describeCandidates(mesh, *n);
+    ASSERT_TRUE(candidates.ok());
+    ASSERT_GT(candidates->size(), 1u);
+    double best = 1.0;
+    for (const Descriptor& c : *candidates)
+      best = std::min(best, core::descriptorDistance(reference, c));
+    worstCanonical = std::max(worstCanonical, core::descriptorDistance(reference, candidates->front()));
+    worstBest = std::max(worstBest, best);
+  }
+  std::cout << "  square bar: worst distance canonical frame only " << worstCanonical << ", best candidate "
+            << worstBest << "\n";
+  EXPECT_LT(worstBest, 0.5 * worstCanonical);
+  EXPECT_LT(worstBest, 0.15);
+}
+
+}  // namespace
+}  // namespace shapedb::volume
