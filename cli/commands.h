@@ -23,6 +23,7 @@ struct Command {
 };
 
 Command addInspectCommand(CLI::App& parent);
+Command addDescribeCommand(CLI::App& parent);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);

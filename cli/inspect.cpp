@@ -10,17 +10,15 @@
 
 #include "commands.h"
 #include "format.h"
+#include "mesh_input.h"
 
 namespace shapedb::cli {
 namespace {
 
 struct InspectOptions {
   std::string meshPath;
-  double density = 1000.0;
   bool json = false;
-  bool approximate = false;
-  bool flipInsideOut = false;
-  bool allowDegenerate = false;
+  MeshInputOptions input;
 };
 
 nlohmann::json topologyJson(const io::LoadedMesh& loaded) {
@@ -99,30 +97,11 @@ void printText(const InspectOptions& options, const io::LoadedMesh& loaded, cons
 }
 
 int runInspect(const InspectOptions& options) {
-  Result<io::LoadedMesh> loaded =
-      io::loadMesh(options.meshPath, {.allowDegenerateFaces = options.allowDegenerate});
-  if (!loaded) {
-    printError(loaded.error().message);
-    return kExitInputError;
-  }
-  const core::MassPropertiesOptions massOptions{.density = options.density,
-                                                .flipInsideOut = options.flipInsideOut,
-                                                .allowApproximate = options.approximate};
-  Result<core::MassProperties> mp = core::computeMassProperties(loaded->mesh, loaded->topology, massOptions);
-  if (!mp) {
-    std::string hint;
-    if (mp.error().code == ErrorCode::kInsideOut) hint = "; --flip-inside-out flips it";
-    if (mp.error().code == ErrorCode::kNotClosed || mp.error().code == ErrorCode::kNonManifold ||
-        mp.error().code == ErrorCode::kInconsistentOrientation)
-      hint = "; --approximate estimates from vertex point masses";
-    printError(options.meshPath + ": " + mp.error().message + hint);
-    return kExitInputError;
-  }
-  Result<core::Normalization> n = core::normalize(loaded->mesh, *mp);
-  if (!n) {
-    printError(options.meshPath + ": " + n.error().message);
-    return kExitInputError;
-  }
+  std::optional<MeshInput> input = loadMeshInput(options.meshPath, options.input);
+  if (!input) return kExitInputError;
+  const io::LoadedMesh* loaded = &input->loaded;
+  const core::MassProperties* mp = &input->massProperties;
+  const core::Normalization* n = &input->normalization;
   if (options.json)
     std::printf("%s\n", reportJson(options, *loaded, *mp, *n).dump(2).c_str());
   else
@@ -142,15 +121,7 @@ Command addInspectCommand(CLI::App& parent) {
       "the shape leaves undetermined. Formats: OBJ, PLY, OFF, STL.");
   app->add_option("MESH", options->meshPath, "Surface mesh file (.obj, .ply, .off, .stl)")->required();
   app->add_flag("--json", options->json, "Print one JSON object with stable field names instead of text");
-  app->add_option("--density", options->density, "Density in kg/m³ for mass and inertia")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app->add_flag(
-      "--approximate", options->approximate,
-      "Accept an open or non-manifold surface: estimate from vertex point masses (marked approximate)");
-  app->add_flag("--flip-inside-out", options->flipInsideOut, "Accept a mesh wound inward by flipping it");
-  app->add_flag("--allow-degenerate", options->allowDegenerate,
-                "Accept degenerate faces (dropped if a vertex repeats, kept if only their area is zero)");
+  addMeshInputFlags(*app, options->input);
   return {app, [options] { return runInspect(*options); }};
 }
 

@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("shapedb " SHAPEDB_VERSION " (OpenVDB ") +
                                         shapedb::volume::openVdbVersion() + ")");
   app.require_subcommand(1);
-  std::vector<Command> commands = {addInspectCommand(app)};
+  std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app)};
 
   try {
     app.parse(argc, argv);
