@@ -1,0 +1,216 @@
+// Describing a mesh and searching the index (issue 3).
+// Targets on the 2-core reference machine:
+//   describe + search <= 50 us p50 for a 5k-triangle mesh against 4,500 entries on one core
+//   (the paper: 4 ms per fragment); search <= 1 ms p50 against 1M entries; <= 1 KiB per entry for
+//   centroid-voxel at N = 10.
+//   build/release/bin/descriptor_bench --benchmark_filter=BM_Search
+// Search counters: p50_us / p99_us per query, distances and bounds computed per query, bytes per entry.
+// Entries beyond the 4,500 real shapes are jittered copies of them (synthetic, for scale).
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <random>
+#include <tuple>
+
+#include <benchmark/benchmark.h>
+
+#include <shapedb/core/index.h>
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/normalize.h>
+#include <shapedb/core/primitives.h>
+#include <shapedb/volume/describe.h>
+
+#include "synthetic.h"
+
+namespace {
+
+using namespace shapedb;
+
+constexpr int kBaseShapes = 4500;
+
+core::DescriptorOptions optionsFor(core::DescriptorKind kind,
+                                   core::Sampling sampling = core::Sampling::kArea) {
+  core::DescriptorOptions o;
+  o.kind = kind;
+  o.sampling = sampling;
+  return o;
+}
+
+core::DescriptorKind kindOf(std::int64_t arg) {
+  return static_cast<core::DescriptorKind>(arg);
+}
+
+// ---- Describe ---------------------------------------------------------------------------------------
+
+// A latitude-longitude ellipsoid of exactly 5,000 or 100,000 triangles, as the mass-properties bench.
+core::TriangleMesh meshOfTriangles(std::int64_t triangles) {
+  return triangles <= 5000 ? core::makeUvEllipsoid({1.0, 1.6, 0.7}, 50, 51)
+                           : core::makeUvEllipsoid({1.0, 1.6, 0.7}, 250, 201);
+}
+
+void BM_Describe(benchmark::State& state) {
+  const core::TriangleMesh mesh = meshOfTriangles(state.range(0));
+  const auto kind = kindOf(state.range(1));
+  const auto sampling = static_cast<core::Sampling>(state.range(2));
+  const core::Normalization n = *core::normalize(mesh, *core::computeMassProperties(mesh));
+  volume::Describer describer(optionsFor(kind, sampling));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(describer.describe(mesh, n));
+  state.SetLabel(std::string(core::toString(kind)) + "/" + core::toString(sampling));
+}
+BENCHMARK(BM_Describe)
+    ->ArgsProduct({{5000, 100000}, {1, 2}, {0, 1}})
+    ->ArgNames({"tris", "kind", "vertices"})
+    ->Unit(benchmark::kMicrosecond);
+
+// ---- Index ------------------------------------------------------------------------------------------
+
+// The 4,500 real shapes each descriptor kind starts from, and shapes outside them to query with.
+struct Shapes {
+  std::vector<core::Descriptor> entries;
+  std::vector<core::Descriptor> queries;
+};
+
+const Shapes& shapes(core::DescriptorKind kind, core::Sampling sampling = core::Sampling::kArea) {
+  static std::map<std::pair<core::DescriptorKind, core::Sampling>, std::unique_ptr<Shapes>> cache;
+  auto& slot = cache[{kind, sampling}];
+  if (!slot) {
+    slot = std::make_unique<Shapes>();
+    std::mt19937_64 rng(1);
+    for (int i = 0; i < kBaseShapes + 500; ++i) {
+      Result<test::DescribedMesh> d =
+          test::describeMesh(test::makeRandomShape(rng, 2), optionsFor(kind, sampling));
+      if (!d) continue;
+      (slot->entries.size() < kBaseShapes ? slot->entries : slot->queries).push_back(d->descriptor);
+    }
+  }
+  return *slot;
+}
+
+const core::Index& indexOf(core::DescriptorKind kind, std::int64_t entries,
+                           core::Sampling sampling = core::Sampling::kArea) {
+  static std::map<std::tuple<core::DescriptorKind, std::int64_t, core::Sampling>,
+                  std::unique_ptr<core::Index>>
+      cache;
+  auto& slot = cache[{kind, entries, sampling}];
+  if (!slot) {
+    const Shapes& s = shapes(kind, sampling);
+    core::IndexBuilder builder(optionsFor(kind, sampling));
+    std::mt19937_64 rng(2);
+    std::uniform_int_distribution<int> flips(0, 6);
+    for (std::int64_t i = 0; i < entries; ++i) {
+      const core::Descriptor& base = s.entries[static_cast<std::size_t>(i % kBaseShapes)];
+      const auto id = static_cast<core::EntryId>(i);
+      (void)builder.add(id, i < kBaseShapes ? base : test::jitterDescriptor(base, rng, flips(rng), 0.1));
+    }
+    slot = std::make_unique<core::Index>(*std::move(builder).build());
+  }
+  return *slot;
+}
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
+}
+
+void BM_Search(benchmark::State& state) {
+  const auto kind = kindOf(state.range(0));
+  const std::int64_t entries = state.range(1);
+  const auto method = static_cast<core::SearchMethod>(state.range(2));
+  const core::Index& index = indexOf(kind, entries);
+  const std::vector<core::Descriptor>& queries = shapes(kind).queries;
+  core::SearchOptions options;
+  options.method = method;
+  options.parallel = method == core::SearchMethod::kBruteForce;
+  std::vector<double> micros;
+  core::SearchStats stats;
+  std::size_t q = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    auto matches = index.search(queries[q++ % queries.size()], options, &stats);
+    const auto stop = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(matches);
+    micros.push_back(std::chrono::duration<double, std::micro>(stop - start).count());
+  }
+  state.counters["p50_us"] = percentile(micros, 0.5);
+  state.counters["p99_us"] = percentile(micros, 0.99);
+  state.counters["distances_per_query"] =
+      static_cast<double>(stats.distanceEvaluations) / static_cast<double>(micros.size());
+  state.counters["bounds_per_query"] =
+      static_cast<double>(stats.boundEvaluations) / static_cast<double>(micros.size());
+  state.counters["bytes_per_entry"] =
+      static_cast<double>(index.memoryBytes()) / static_cast<double>(index.size());
+  state.SetLabel(std::string(core::toString(kind)) + " " + core::toString(method));
+}
+BENCHMARK(BM_Search)
+    ->ArgsProduct({{0, 1, 2}, {kBaseShapes, 100000, 1000000}, {1}})
+    ->ArgNames({"kind", "entries", "method"})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK(BM_Search)
+    ->ArgsProduct({{0, 1, 2}, {kBaseShapes}, {0}})
+    ->ArgNames({"kind", "entries", "method"})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+// The paper's ±r buckets: how often its top-1 differs from the exact one, and what it costs.
+void BM_SearchBuckets(benchmark::State& state) {
+  const auto kind = kindOf(state.range(0));
+  const core::Index& index = indexOf(kind, state.range(1));
+  const std::vector<core::Descriptor>& queries = shapes(kind).queries;
+  core::SearchOptions exact, buckets;
+  buckets.method = core::SearchMethod::kBuckets;
+  buckets.bucketRadius = static_cast<int>(state.range(2));
+  std::size_t q = 0, misses = 0, searches = 0;
+  core::SearchStats stats;
+  for (auto _ : state) {
+    const core::Descriptor& query = queries[q++ % queries.size()];
+    auto found = index.search(query, buckets, &stats);
+    state.PauseTiming();
+    auto truth = index.search(query, exact);
+    if (found->empty() || found->front().entry != truth->front().entry) ++misses;
+    ++searches;
+    state.ResumeTiming();
+  }
+  state.counters["miss_rate"] = static_cast<double>(misses) / static_cast<double>(searches);
+  state.counters["distances_per_query"] =
+      static_cast<double>(stats.distanceEvaluations) / static_cast<double>(searches);
+}
+BENCHMARK(BM_SearchBuckets)
+    ->ArgsProduct({{1, 2}, {kBaseShapes}, {0, 2, 6, 12}})
+    ->ArgNames({"kind", "entries", "r"})
+    ->Unit(benchmark::kMicrosecond);
+
+// ---- Describe + search: the query's hot path after normalization -----------------------------------
+
+void BM_DescribeAndSearch(benchmark::State& state) {
+  const auto kind = kindOf(state.range(0));
+  const auto sampling = static_cast<core::Sampling>(state.range(1));
+  const core::TriangleMesh mesh = test::makeLopsidedBlob({1.0, 1.6, 0.7}, 4);  // 5,120 triangles
+  const core::Normalization n = *core::normalize(mesh, *core::computeMassProperties(mesh));
+  const core::Index& index = indexOf(kind, kBaseShapes, sampling);
+  volume::Describer describer(optionsFor(kind, sampling));
+  std::vector<double> micros;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    auto candidates = describer.describeCandidates(mesh, n);
+    auto matches = index.search(*candidates);
+    const auto stop = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(matches);
+    micros.push_back(std::chrono::duration<double, std::micro>(stop - start).count());
+  }
+  state.counters["p50_us"] = percentile(micros, 0.5);
+  state.counters["p99_us"] = percentile(micros, 0.99);
+  state.counters["triangles"] = static_cast<double>(mesh.triangleCount());
+  state.SetLabel(std::string(core::toString(kind)) + "/" + core::toString(sampling) +
+                 ", target p50 <= 50 us");
+}
+BENCHMARK(BM_DescribeAndSearch)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->ArgNames({"kind", "vertices"})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+}  // namespace
