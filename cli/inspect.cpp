@@ -61,7 +61,9 @@ nlohmann::json reportJson(const InspectOptions& options, const io::LoadedMesh& l
             {"moment_gaps", n.momentGaps},
             {"conditioning", n.conditioning()},
             {"skewness", n.skewness},
-            {"sign_ambiguous", n.signAmbiguous}}},
+            {"sign_ambiguous", n.signAmbiguous},
+            {"plane_symmetry", n.planeSymmetry},
+            {"distinct_axis_ambiguous", n.distinctAxisAmbiguous}}},
           {"approximate", mp.isApproximate},
           {"flipped", mp.wasFlipped}};
 }

@@ -1,4 +1,6 @@
 #include <cmath>
+#include <complex>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -58,6 +60,45 @@ std::array<double, 2> thirdMomentsOfVertices(const TriangleMesh& mesh, const Mas
   return {sumX * toVolume, sumY * toVolume};
 }
 
+// The strongest angular harmonic of the surface about axis d, over the plane basis (e1, e2):
+// μ_m = Σ A (u + i v)^m over triangle centroids (u, v) about c, normalized by Σ A |u + i v|^m.
+// Returns {m, phase} of the largest normalized magnitude of order 2..6, or m = 0 if none reaches
+// `tolerance`.
+std::pair<int, double> strongestHarmonic(const TriangleMesh& mesh, const Vec3& c, const Vec3& e1,
+                                         const Vec3& e2, double tolerance) {
+  constexpr int kMaxOrder = 6;
+  std::array<std::complex<double>, kMaxOrder + 1> sum{};
+  std::array<double, kMaxOrder + 1> norm{};
+  for (const auto& t : mesh.triangles) {
+    const Vec3& a = mesh.vertices[t[0]];
+    const Vec3& b = mesh.vertices[t[1]];
+    const Vec3& d = mesh.vertices[t[2]];
+    const double area = 0.5 * (b - a).cross(d - a).norm();
+    const Vec3 r = (a + b + d) / 3.0 - c;
+    const std::complex<double> z(r.dot(e1), r.dot(e2));
+    const double radius = std::abs(z);
+    std::complex<double> power = z;
+    double radiusPower = radius;
+    for (int m = 2; m <= kMaxOrder; ++m) {
+      power *= z;
+      radiusPower *= radius;
+      sum[static_cast<std::size_t>(m)] += area * power;
+      norm[static_cast<std::size_t>(m)] += area * radiusPower;
+    }
+  }
+  int best = 0;
+  double bestStrength = tolerance;
+  for (int m = 2; m <= kMaxOrder; ++m) {
+    const auto i = static_cast<std::size_t>(m);
+    const double strength = norm[i] > 0.0 ? std::abs(sum[i]) / norm[i] : 0.0;
+    if (strength >= bestStrength * (1.0 + 1e-9)) {
+      best = m;
+      bestStrength = strength;
+    }
+  }
+  return {best, best > 0 ? std::arg(sum[static_cast<std::size_t>(best)]) : 0.0};
+}
+
 }  // namespace
 
 Result<Normalization> normalize(const TriangleMesh& mesh, const MassProperties& massProperties,
@@ -87,19 +128,62 @@ Result<Normalization> normalize(const TriangleMesh& mesh, const MassProperties& 
                    : highPair          ? AxisDegeneracy::kYZ
                                        : AxisDegeneracy::kNone;
 
-  // Sign rule: positive third moment along x and y; skewness says how reliable that is.
-  const std::array<double, 2> m3 = mp.isApproximate ? thirdMomentsOfVertices(mesh, mp, x, y)
-                                                    : thirdMomentsExact(mesh, mp.centerOfMass, x, y);
-  // Second moments along x and y (unit density): σ² V = ∫(u·r)² dV = (tr(I) / 2 − λ) / ρ.
+  // Sign rule: positive third moment along two axes; skewness says how reliable that is. In a
+  // degenerate plane only the distinct axis takes it (the pair below is set by the harmonic).
+  const Vec3 zEigen = eigen.eigenvectors().col(2);
+  const bool pairXY = out.degeneracy == AxisDegeneracy::kXY, pairYZ = out.degeneracy == AxisDegeneracy::kYZ;
+  Vec3 first = pairXY ? zEigen : x;  // the axis whose moment is m[iFirst]
+  Vec3 second = pairXY ? x : y;
+  const std::array<int, 2> moment = {pairXY ? 2 : 0, pairXY ? 0 : 1};
+  const std::array<double, 2> m3 = mp.isApproximate ? thirdMomentsOfVertices(mesh, mp, first, second)
+                                                    : thirdMomentsExact(mesh, mp.centerOfMass, first, second);
+  // Second moments along an axis (unit density): σ² V = ∫(u·r)² dV = (tr(I) / 2 − λ) / ρ.
   const double halfTrace = 0.5 * m.sum();
-  const std::array<double, 2> m2 = {(halfTrace - m[0]) / mp.density, (halfTrace - m[1]) / mp.density};
-  Vec3* axes[2] = {&x, &y};
+  Vec3* axes[2] = {&first, &second};
+  std::array<double, 2> skewness{};
   for (int i = 0; i < 2; ++i) {
-    const double sigma = std::sqrt(std::max(m2[i], 0.0) / mp.volume);
-    const double skew = sigma > 0.0 ? m3[i] / (mp.volume * sigma * sigma * sigma) : 0.0;
+    const double m2 = (halfTrace - m[moment[static_cast<std::size_t>(i)]]) / mp.density;
+    const double sigma = std::sqrt(std::max(m2, 0.0) / mp.volume);
+    const double skew =
+        sigma > 0.0 ? m3[static_cast<std::size_t>(i)] / (mp.volume * sigma * sigma * sigma) : 0.0;
     if (skew < 0.0) *axes[i] = -*axes[i];
-    out.skewness[i] = std::abs(skew);
-    out.signAmbiguous[i] = out.skewness[i] < options.signTolerance;
+    skewness[static_cast<std::size_t>(i)] = std::abs(skew);
+  }
+  if (pairXY || pairYZ) {
+    // The distinct axis d keeps its sign rule; (e1, e2, d) right-handed spans the plane, turned so that
+    // the surface's strongest angular harmonic has phase 0: u' + i v' = e^{iθ}(u + i v), θ = −φ/m.
+    const Vec3 d = first;
+    Vec3 e1 = pairXY ? second : y;
+    if (pairYZ) e1 = (e1 - e1.dot(d) * d).normalized();
+    Vec3 e2 = d.cross(e1);
+    const auto [order, phase] = strongestHarmonic(mesh, mp.centerOfMass, e1, e2, options.harmonicTolerance);
+    if (order > 0) {
+      const double theta = -phase / order;
+      const Vec3 r1 = std::cos(theta) * e1 - std::sin(theta) * e2,
+                 r2 = std::sin(theta) * e1 + std::cos(theta) * e2;
+      e1 = r1;
+      e2 = r2;
+    }
+    out.planeSymmetry = order;
+    out.distinctAxisAmbiguous = skewness[0] < options.signTolerance;
+    if (pairXY) {
+      x = e1;
+      y = e2;
+      out.skewness = {0.0, 0.0};
+      out.signAmbiguous = {order == 0, order == 0};
+    } else {
+      x = d;
+      y = e1;
+      out.skewness = {skewness[0], 0.0};
+      out.signAmbiguous = {out.distinctAxisAmbiguous, order == 0};
+    }
+  } else {
+    x = first;
+    y = second;
+    out.skewness = skewness;
+    for (int i = 0; i < 2; ++i)
+      out.signAmbiguous[static_cast<std::size_t>(i)] =
+          skewness[static_cast<std::size_t>(i)] < options.signTolerance;
   }
   const Vec3 z = x.cross(y);
   out.principalAxes.col(0) = x;

@@ -41,7 +41,10 @@ std::vector<Mat3> orientationCandidates(const Normalization& normalization,
   std::vector<Mat3> out = {Mat3::Identity()};
   if (!options.enabled) return out;
   const bool flipX = normalization.signAmbiguous[0], flipY = normalization.signAmbiguous[1];
-  const int steps = std::max(options.planeSteps, 1);
+  // In a degenerate plane the harmonic (if any) leaves planeSymmetry turns open, else planeSteps.
+  const int steps =
+      normalization.planeSymmetry > 0 ? normalization.planeSymmetry : std::max(options.planeSteps, 1);
+  const bool reverse = normalization.distinctAxisAmbiguous;
   const auto aroundAxis = [&](const Vec3& axis, bool reverseAxis, const Mat3& reversal) {
     for (int reversed = 0; reversed <= (reverseAxis ? 1 : 0); ++reversed)
       for (int j = 0; j < steps; ++j) {
@@ -57,11 +60,10 @@ std::vector<Mat3> orientationCandidates(const Normalization& normalization,
       if (flipX && flipY) out.push_back(kFlipXY);
       break;
     case AxisDegeneracy::kXY:
-      // x and y are arbitrary in their plane, so z = x × y has no meaningful sign either.
-      aroundAxis(Vec3::UnitZ(), true, kFlipYZ);
+      aroundAxis(Vec3::UnitZ(), reverse, kFlipYZ);
       break;
     case AxisDegeneracy::kYZ:
-      aroundAxis(Vec3::UnitX(), flipX, kFlipXZ);
+      aroundAxis(Vec3::UnitX(), reverse, kFlipXZ);
       break;
     case AxisDegeneracy::kAll:
       for (const Mat3& rotation : sampleRotations(options.sphereSamples))

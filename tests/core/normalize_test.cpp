@@ -1,5 +1,6 @@
 #include <random>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <shapedb/core/mass_properties.h>
@@ -95,6 +96,44 @@ TEST(Normalize, CylindersAreFlaggedOnTheirEqualPair) {
   EXPECT_EQ(canonicalize(makeCylinder(0.5, 4.0, 64)).normalization.degeneracy, AxisDegeneracy::kYZ);
   // Flat: the axis carries the largest moment.
   EXPECT_EQ(canonicalize(makeCylinder(2.0, 0.5, 64)).normalization.degeneracy, AxisDegeneracy::kXY);
+}
+
+// Prisms of n-gon section have equal moments in the section plane; an angular harmonic of order m, a
+// multiple of n (≤ 6), sets the in-plane axes, so a moved copy gets the same canonical mesh up to a turn
+// of 360°/m about the distinct axis (and a reversal of that axis, the prism being mirror-symmetric).
+TEST(Normalize, PrismSectionHarmonicFixesTheDegeneratePlane) {
+  std::mt19937_64 rng(8);
+  for (int sides : {3, 4, 5, 6}) {
+    for (double height : {4.0, 0.3}) {  // long (kYZ) and flat (kXY)
+      SCOPED_TRACE(std::to_string(sides) + " sides, height " + std::to_string(height));
+      const TriangleMesh prism = makeCylinder(1.0, height, sides);
+      const Canonical reference = canonicalize(prism);
+      ASSERT_TRUE(reference.normalization.isDegenerate());
+      const int m = reference.normalization.planeSymmetry;
+      ASSERT_GT(m, 0);
+      EXPECT_EQ(m % sides, 0);
+      for (int trial = 0; trial < 20; ++trial) {
+        const Canonical moved = canonicalize(transformed(prism, test::randomSimilarity(rng)));
+        EXPECT_EQ(moved.normalization.planeSymmetry, m);
+        // Some turn by a multiple of 360°/n about the distinct axis (or that and a reversal) maps the
+        // moved canonical mesh onto the reference's, vertex for vertex.
+        const Vec3 axis =
+            reference.normalization.degeneracy == AxisDegeneracy::kYZ ? Vec3::UnitX() : Vec3::UnitZ();
+        const Vec3 across = axis == Vec3::UnitX() ? Vec3::UnitY() : Vec3::UnitX();  // the first in-plane axis
+        double best = 1e9;
+        for (int reversed = 0; reversed < 2; ++reversed)
+          for (int j = 0; j < m; ++j) {
+            Mat3 r = Eigen::AngleAxisd(2.0 * 3.141592653589793 * j / m, axis).toRotationMatrix();
+            if (reversed) r = r * Eigen::AngleAxisd(3.141592653589793, across).toRotationMatrix();
+            Mat4 turn = Mat4::Identity();
+            turn.topLeftCorner<3, 3>() = r;
+            best = std::min(best, test::maxVertexDifference(transformed(moved.mesh, turn), reference.mesh));
+          }
+        EXPECT_LT(best, 1e-9);
+      }
+    }
+  }
+  EXPECT_EQ(canonicalize(makeCylinder(1.0, 4.0, 64)).normalization.planeSymmetry, 0);  // round: no harmonic
 }
 
 TEST(Normalize, MirrorSymmetricBoxHasAmbiguousSigns) {

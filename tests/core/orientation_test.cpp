@@ -3,6 +3,7 @@
 #include <numbers>
 #include <random>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <shapedb/core/orientation.h>
@@ -52,12 +53,26 @@ TEST(Orientation, DegeneratePlaneTurnsAboutTheDistinctAxis) {
   EXPECT_EQ(turns.size(), 8u);  // x's sign is determined
   for (const Mat3& r : turns)
     EXPECT_TRUE(r.col(0).isApprox(Vec3::UnitX()));
-  n.signAmbiguous[0] = true;
+  n.distinctAxisAmbiguous = true;
   EXPECT_EQ(orientationCandidates(n, options).size(), 16u);
   n.degeneracy = AxisDegeneracy::kXY;
   const std::vector<Mat3> aboutZ = orientationCandidates(n, options);
   expectProperRotations(aboutZ);
-  EXPECT_EQ(aboutZ.size(), 16u);  // z's sign is never determined there
+  EXPECT_EQ(aboutZ.size(), 16u);
+  for (const Mat3& r : aboutZ)
+    EXPECT_NEAR(std::abs(r(2, 2)), 1.0, 1e-12);
+}
+
+TEST(Orientation, HarmonicSetsThePlaneUpToItsSymmetry) {
+  Normalization n;
+  n.degeneracy = AxisDegeneracy::kYZ;
+  n.planeSymmetry = 4;  // a square bar: quarter turns
+  const std::vector<Mat3> turns = orientationCandidates(n);
+  expectProperRotations(turns);
+  ASSERT_EQ(turns.size(), 4u);
+  EXPECT_TRUE(turns[1].isApprox(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitX()).toRotationMatrix()));
+  n.distinctAxisAmbiguous = true;
+  EXPECT_EQ(orientationCandidates(n).size(), 8u);
 }
 
 TEST(Orientation, SphereLikeShapesSampleAllRotations) {

@@ -17,6 +17,9 @@ struct NormalizeOptions {
   /// An axis whose standardized third moment (skewness) is below this in magnitude has no reliable
   /// sign: the shape is (nearly) mirror-symmetric across the plane normal to it.
   double signTolerance = 0.02;
+  /// Where two moments are equal, the in-plane axes are set by the strongest of the surface's angular
+  /// harmonics of order 2 to 6 about the distinct axis, if its normalized magnitude reaches this.
+  double harmonicTolerance = 0.05;
 };
 
 /// Which principal axes the moments leave undetermined.
@@ -42,7 +45,15 @@ struct Normalization {
   /// Standardized third moments ∫x³/(V σ³) along x and y after the sign rule: both ≥ 0.
   std::array<double, 2> skewness{};
   /// The sign rule could not decide axis x (index 0) or y (index 1): |skewness| < signTolerance.
+  /// In a degenerate plane an in-plane axis is ambiguous unless planeSymmetry set it.
   std::array<bool, 2> signAmbiguous{};
+  /// Degenerate pair (kXY, kYZ) only: m ≥ 2 when the in-plane axes were turned so that the surface's
+  /// m-th angular harmonic about the distinct axis has phase 0 (a square bar: m = 4, a triangular
+  /// prism: m = 3); the frame is then determined up to turns of 360°/m. 0: no harmonic is strong
+  /// enough (cylinder-like), the in-plane axes are arbitrary.
+  int planeSymmetry = 0;
+  /// Degenerate pair only: the distinct axis (z for kXY, x for kYZ) has no reliable sign.
+  bool distinctAxisAmbiguous = false;
   bool isApproximate = false;  ///< built on approximate mass properties
 
   /// min(momentGaps): 0 for a sphere, near 1 for a needle.
@@ -52,7 +63,9 @@ struct Normalization {
 
 /// The canonical frame of `mesh` given its mass properties (computeMassProperties on the same mesh).
 /// Sign rule: the third moment of the volume about the centre of mass is made positive along x and y;
-/// z = x × y keeps the frame right-handed. O(F); thread-safe (pure function).
+/// z = x × y keeps the frame right-handed. Where two moments are equal, the distinct axis gets the sign
+/// rule and the other two are set by the surface's angular harmonic (planeSymmetry). O(F); thread-safe
+/// (pure function).
 /// Errors: kInvalidArgument if the mass properties are not finite or positive.
 Result<Normalization> normalize(const TriangleMesh& mesh, const MassProperties& massProperties,
                                 const NormalizeOptions& options = {});

@@ -10,8 +10,10 @@ namespace shapedb::core {
 /// How many orientations a query tries where its canonical frame is undetermined.
 struct OrientationOptions {
   bool enabled = true;  ///< false: the canonical frame only
-  /// Rotations tried about the distinct axis when two principal moments are equal (kXY, kYZ): every
-  /// 360°/planeSteps, each also with the distinct axis reversed when its sign is undetermined.
+  /// Rotations tried about the distinct axis when two principal moments are equal (kXY, kYZ) and no
+  /// harmonic set the in-plane axes (Normalization::planeSymmetry = 0): every 360°/planeSteps. With
+  /// planeSymmetry = m, the m turns of 360°/m. Each also with the distinct axis reversed when its sign
+  /// is undetermined.
   int planeSteps = 24;
   /// Rotations tried when all three moments are equal (kAll): a near-uniform sample of SO(3).
   int sphereSamples = 72;
@@ -22,6 +24,8 @@ struct OrientationOptions {
 /// - each axis flip the sign rule left ambiguous (rotations by π about y, x, or z, keeping det +1);
 /// - within a degenerate eigenspace, rotations about the distinct axis (kXY, kYZ) or a sample of all
 ///   rotations (kAll).
+/// Each candidate is a proper rotation of the canonical frame that the normalization could equally have
+/// chosen for a copy of the shape.
 /// Deterministic; proper rotations only (a mirror image is another shape). Thread-safe.
 std::vector<Mat3> orientationCandidates(const Normalization& normalization,
                                         const OrientationOptions& options = {});
