@@ -1,5 +1,6 @@
 #include <cassert>
 #include <cmath>
+#include <string>
 
 #include <shapedb/core/descriptor.h>
 
@@ -11,6 +12,34 @@ Vec3 Descriptor::canonicalCentroid(std::size_t index) const {
   const Vec3 ijk(cell % n, (cell / n) % n, cell / (n * n));
   const double lo = -0.5 * gridSize * cellSize;
   return Vec3::Constant(lo) + cellSize * (ijk + centroids[index]);
+}
+
+Status validateDescriptor(const Descriptor& d, const DescriptorOptions& options) {
+  const auto fail = [](const std::string& what) {
+    return Error{ErrorCode::kInvalidArgument, "descriptor: " + what};
+  };
+  if (d.kind != options.kind)
+    return fail(std::string("is ") + toString(d.kind) + ", expected " + toString(options.kind));
+  if (!d.moments.allFinite()) return fail("moments are not finite");
+  if (d.kind == DescriptorKind::kMoment) return Ok{};
+  if (d.sampling != options.sampling || d.gridSize != options.gridSize)
+    return fail("grid " + std::to_string(d.gridSize) + " with " + toString(d.sampling) +
+                " sampling, expected " + std::to_string(options.gridSize) + " with " +
+                toString(options.sampling));
+  const auto cellCount = static_cast<std::uint64_t>(d.gridSize) * d.gridSize * d.gridSize;
+  for (std::size_t i = 0; i < d.cells.size(); ++i) {
+    if (d.cells[i] >= cellCount) return fail("cell " + std::to_string(d.cells[i]) + " is outside the grid");
+    if (i > 0 && d.cells[i] <= d.cells[i - 1]) return fail("cells are not strictly ascending");
+  }
+  if (d.kind == DescriptorKind::kCentroidVoxel) {
+    if (d.centroids.size() != d.cells.size())
+      return fail(std::to_string(d.centroids.size()) + " centroids for " + std::to_string(d.cells.size()) +
+                  " cells");
+    for (const Vec3& c : d.centroids)
+      if (!(c.array() >= 0.0).all() || !(c.array() <= 1.0).all())
+        return fail("a centroid is outside its cell");
+  }
+  return Ok{};
 }
 
 double momentDistance(const Vec3& a, const Vec3& b) {

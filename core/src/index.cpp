@@ -397,16 +397,9 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
   if (candidates.empty())
     return Error{ErrorCode::kInvalidArgument, "search needs at least one query descriptor"};
   if (options.k < 1) return Error{ErrorCode::kInvalidArgument, "k must be at least 1"};
-  for (const Descriptor& d : candidates) {
-    if (d.kind != mOptions.kind)
-      return Error{ErrorCode::kInvalidArgument, std::string("query descriptor is ") + toString(d.kind) +
-                                                    ", the index holds " + toString(mOptions.kind)};
-    if (isGrid(d.kind) && (d.gridSize != mOptions.gridSize || d.sampling != mOptions.sampling))
-      return Error{ErrorCode::kInvalidArgument,
-                   "query descriptor has grid " + std::to_string(d.gridSize) + " with " +
-                       toString(d.sampling) + " sampling, the index " + std::to_string(mOptions.gridSize) +
-                       " with " + toString(mOptions.sampling)};
-  }
+  for (const Descriptor& d : candidates)
+    if (Status valid = validateDescriptor(d, mOptions); !valid)
+      return Error{valid.error().code, "query " + valid.error().message};
   SearchStats local;
   SearchStats& st = stats ? *stats : local;
   const auto k = static_cast<std::size_t>(options.k);
@@ -463,11 +456,8 @@ IndexBuilder::IndexBuilder(const DescriptorOptions& options) : mOptions(options)
 }
 
 Status IndexBuilder::add(EntryId id, const Descriptor& d) {
-  if (d.kind != mOptions.kind ||
-      (isGrid(d.kind) && (d.gridSize != mOptions.gridSize || d.sampling != mOptions.sampling)))
-    return Error{
-        ErrorCode::kInvalidArgument,
-        "entry " + std::to_string(id) + ": descriptor of another kind, grid or sampling than the index"};
+  if (Status valid = validateDescriptor(d, mOptions); !valid)
+    return Error{valid.error().code, "entry " + std::to_string(id) + ": " + valid.error().message};
   mIds.push_back(id);
   if (!isGrid(d.kind)) {
     mMoments.push_back(d.moments);

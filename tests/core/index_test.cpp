@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iostream>
 #include <map>
 #include <random>
@@ -215,6 +216,26 @@ TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
   zero.k = 0;
   EXPECT_EQ(index.search(bases[0], zero).error().code, ErrorCode::kInvalidArgument);
   EXPECT_EQ(index.search(std::span<const Descriptor>()).error().code, ErrorCode::kInvalidArgument);
+
+  // Malformed descriptors (as a corrupted file could hold) are refused, not indexed out of bounds.
+  IndexBuilder strict(optionsFor(DescriptorKind::kVoxel));
+  Descriptor bad = bases[0];
+  bad.cells.push_back(1000);
+  EXPECT_NE(strict.add(1, bad).error().message.find("outside the grid"), std::string::npos);
+  EXPECT_NE(index.search(bad).error().message.find("outside the grid"), std::string::npos);
+  bad = bases[0];
+  std::swap(bad.cells[0], bad.cells[1]);
+  EXPECT_NE(strict.add(1, bad).error().message.find("ascending"), std::string::npos);
+  bad = bases[0];
+  bad.kind = DescriptorKind::kCentroidVoxel;
+  bad.centroids.pop_back();
+  IndexBuilder centroidBuilder(optionsFor(DescriptorKind::kCentroidVoxel));
+  EXPECT_NE(centroidBuilder.add(1, bad).error().message.find("centroids for"), std::string::npos);
+  bad.centroids.push_back(Vec3(0.5, 1.5, 0.5));
+  EXPECT_NE(centroidBuilder.add(1, bad).error().message.find("outside its cell"), std::string::npos);
+  bad = bases[0];
+  bad.moments[1] = std::nan("");
+  EXPECT_NE(strict.add(1, bad).error().message.find("not finite"), std::string::npos);
 
   IndexBuilder builder(optionsFor(DescriptorKind::kVoxel));
   ASSERT_TRUE(builder.add(4, bases[0]).ok());

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <random>
 
@@ -95,6 +96,22 @@ TEST(Describe, RejectsOptionsOutOfRange) {
     EXPECT_EQ(d.error().code, ErrorCode::kInvalidArgument);
     EXPECT_NE(d.error().message.find("grid size"), std::string::npos);
   }
+}
+
+TEST(Describe, RefusesMalformedMeshesInsteadOfReadingOutOfBounds) {
+  TriangleMesh mesh = core::makeBox(Vec3(1, 2, 3));
+  const core::Normalization n = *core::normalize(mesh, *core::computeMassProperties(mesh));
+  TriangleMesh broken = mesh;
+  broken.triangles[3][1] = 99;
+  Result<Descriptor> d = describe(broken, n);
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.error().code, ErrorCode::kIndexOutOfRange);
+  EXPECT_NE(d.error().message.find("triangle 3 refers to vertex 99 of 8"), std::string::npos);
+  broken = mesh;
+  broken.vertices[2].y() = std::numeric_limits<double>::quiet_NaN();
+  d = describe(broken, n);
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.error().code, ErrorCode::kNonFinite);
 }
 
 // The must-show invariance: 1,000 random rigid transforms and scales, the same descriptor, and the

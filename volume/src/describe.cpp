@@ -264,6 +264,12 @@ Result<core::Descriptor> Describer::describe(const core::TriangleMesh& mesh,
   if (mOptions.kind == DescriptorKind::kMoment) return out;
 
   // Vertices into the candidate frame; the grid's side is the largest extent there (§4.2).
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (std::uint32_t v : mesh.triangles[t])
+      if (v >= mesh.vertices.size())
+        return Error{ErrorCode::kIndexOutOfRange, "triangle " + std::to_string(t) + " refers to vertex " +
+                                                      std::to_string(v) + " of " +
+                                                      std::to_string(mesh.vertices.size())};
   Impl& s = *mImpl;
   const Mat3 linear = orientation * normalization.canonicalFromMesh.topLeftCorner<3, 3>();
   const Vec3 offset = orientation * normalization.canonicalFromMesh.topRightCorner<3, 1>();
@@ -271,6 +277,9 @@ Result<core::Descriptor> Describer::describe(const core::TriangleMesh& mesh,
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     const Vec3 p = linear * mesh.vertices[i] + offset;
+    if (!p.allFinite())
+      return Error{ErrorCode::kNonFinite,
+                   "vertex " + std::to_string(i) + " is not finite in the canonical frame"};
     s.cellCoords[i] = p;
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);

@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include <shapedb/core/result.h>
 #include <shapedb/core/types.h>
 
 namespace shapedb::core {
@@ -61,6 +62,13 @@ struct Descriptor {
   /// The centroid of filled cell `index` (position in `cells`) in the canonical frame.
   Vec3 canonicalCentroid(std::size_t index) const;
 };
+
+/// Checks that `d` is a well-formed descriptor of the kind, sampling and grid size `options` name:
+/// finite moments; for the voxel kinds, cells strictly ascending and below N³, one centroid per cell
+/// (centroid-voxel), each coordinate in [0, 1]. What the index checks before it trusts a descriptor
+/// (a query's, or an entry's read back from a file).
+/// Errors: kInvalidArgument naming the first problem.
+Status validateDescriptor(const Descriptor& d, const DescriptorOptions& options);
 
 /// Paper eq. (4): ‖m₁ − m₂‖², squared distance of the sorted moments.
 double momentDistance(const Vec3& a, const Vec3& b);

@@ -34,7 +34,8 @@ class Describer {
   /// The descriptor of `mesh` in the frame orientation · canonicalFromMesh (orientation: a rotation,
   /// candidateFromCanonical; identity for the canonical frame itself). `normalization` comes from
   /// core::normalize on the same mesh.
-  /// Errors: kInvalidArgument for options out of range or a mesh without extent.
+  /// Errors: kInvalidArgument for options out of range or a mesh without extent; kIndexOutOfRange,
+  /// kNonFinite for a mesh that validateMesh would refuse.
   Result<core::Descriptor> describe(const core::TriangleMesh& mesh, const core::Normalization& normalization,
                                     const core::Mat3& orientation = core::Mat3::Identity());
 
