@@ -5,7 +5,10 @@
 //   centroid-voxel at N = 10.
 //   build/release/bin/descriptor_bench --benchmark_filter=BM_Search
 // Search counters: p50_us / p99_us per query, distances and bounds computed per query, bytes per entry.
-// Entries beyond the 4,500 real shapes are jittered copies of them (synthetic, for scale).
+// Entries beyond the 4,500 real shapes are jittered copies of them (synthetic, for scale); queries are
+// 500 other random shapes. Results per machine: bench/results/<machine>/descriptor_bench_<family>.csv,
+//   for f in Describe Search SearchBuckets DescribeAndSearch; do build/release/bin/descriptor_bench
+//     --benchmark_filter="^BM_$f/" --benchmark_out=descriptor_bench_$f.csv --benchmark_out_format=csv; done
 
 #include <algorithm>
 #include <chrono>
