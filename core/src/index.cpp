@@ -233,6 +233,8 @@ double Index::gridDistance(const Query& q, std::size_t slot, double threshold) c
   const auto value = [&](std::uint64_t terms) {
     return (static_cast<double>(exclusive) + static_cast<double>(terms) * kTermUnit) / total;
   };
+  // The mismatches alone may already put the entry beyond the threshold.
+  if (value(0) > threshold) return value(0);
   const auto& table = centroidDistanceTable();
   const std::uint16_t* centroids = &mCentroids[mCentroidBegin[slot]];
   std::uint64_t terms = 0;
