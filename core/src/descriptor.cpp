@@ -7,9 +7,8 @@
 namespace shapedb::core {
 
 Vec3 Descriptor::canonicalCentroid(std::size_t index) const {
-  const std::uint32_t cell = cells[index];
-  const std::uint32_t n = static_cast<std::uint32_t>(gridSize);
-  const Vec3 ijk(cell % n, (cell / n) % n, cell / (n * n));
+  const std::array<int, 3> c = cellCoordinates(cells[index], gridSize);
+  const Vec3 ijk(c[0], c[1], c[2]);
   const double lo = -0.5 * gridSize * cellSize;
   return Vec3::Constant(lo) + cellSize * (ijk + centroids[index]);
 }

@@ -58,9 +58,10 @@ CountProfile countProfile(const std::uint64_t* bits, int n) {
   for (int w = 0; w * 64 < cells; ++w)
     for (std::uint64_t word = bits[w]; word != 0; word &= word - 1) {
       const int cell = w * 64 + std::countr_zero(word);
-      const int ijk[3] = {cell % n, cell / n % n, cell / (n * n)};
+      const std::array<int, 3> ijk = cellCoordinates(static_cast<std::uint32_t>(cell), n);
       for (int axis = 0; axis < 3; ++axis)
-        ++slabs[static_cast<std::size_t>(axis * kProfileBins + bin(ijk[axis], kProfileBins))];
+        ++slabs[static_cast<std::size_t>(axis * kProfileBins +
+                                         bin(ijk[static_cast<std::size_t>(axis)], kProfileBins))];
       ++blocks[static_cast<std::size_t>(
           bin(ijk[0], kBlocksPerAxis) +
           kBlocksPerAxis * (bin(ijk[1], kBlocksPerAxis) + kBlocksPerAxis * bin(ijk[2], kBlocksPerAxis)))];

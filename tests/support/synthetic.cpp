@@ -91,10 +91,10 @@ core::Descriptor jitterDescriptor(const core::Descriptor& d, std::mt19937_64& rn
       continue;
     }
     const int cell = static_cast<int>(cells[pick].first);
-    int ijk[3] = {cell % n, cell / n % n, cell / (n * n)};
-    const int axis = static_cast<int>(unit(rng) * 3.0) % 3;
+    std::array<int, 3> ijk = core::cellCoordinates(static_cast<std::uint32_t>(cell), n);
+    const auto axis = static_cast<std::size_t>(unit(rng) * 3.0) % 3;
     ijk[axis] = std::clamp(ijk[axis] + (unit(rng) < 0.5 ? -1 : 1), 0, n - 1);
-    const auto neighbour = static_cast<std::uint32_t>(ijk[0] + n * (ijk[1] + n * ijk[2]));
+    const std::uint32_t neighbour = core::linearCell(ijk[0], ijk[1], ijk[2], n);
     if (std::none_of(cells.begin(), cells.end(), [&](const auto& c) { return c.first == neighbour; }))
       cells.emplace_back(neighbour, core::Vec3(unit(rng), unit(rng), unit(rng)));
   }

@@ -76,7 +76,12 @@ struct Describer::Impl {
   std::vector<std::uint8_t> onPlane;            // bit a: the vertex lies on an interior cell plane ⟂ axis a
   AccumulatorTree tree{Accumulator(0.0)};
   openvdb::tree::ValueAccessor<AccumulatorTree> accessor{tree};
-  std::vector<std::pair<std::uint32_t, Accumulator>> filled;
+  struct FilledCell {
+    std::uint32_t linearIndex;
+    openvdb::Coord ijk;
+    Accumulator value;
+  };
+  std::vector<FilledCell> filled;
   int gridSize = 0;
 
   // Consecutive triangles of a mesh mostly land in the same cell: sum there first, then write the
@@ -85,8 +90,6 @@ struct Describer::Impl {
   Accumulator pending{0.0};
   Leaf* leaf = nullptr;
   openvdb::Coord leafOrigin;
-
-  int clampCell(double u) const { return std::clamp(static_cast<int>(std::floor(u)), 0, gridSize - 1); }
 
   // The cell of coordinate u along an axis for a surface whose normal has component `normal` there.
   // Surface lying on a cell plane belongs to the cell behind it (inside the solid): a box face on a
@@ -321,15 +324,13 @@ Result<core::Descriptor> Describer::describe(const core::TriangleMesh& mesh,
   s.filled.clear();
   for (auto it = s.tree.cbeginValueOn(); it; ++it) {
     const openvdb::Coord ijk = it.getCoord();
-    const auto linearIndex = static_cast<std::uint32_t>(ijk.x() + n * (ijk.y() + n * ijk.z()));
-    s.filled.emplace_back(linearIndex, *it);
+    s.filled.push_back({core::linearCell(ijk.x(), ijk.y(), ijk.z(), n), ijk, *it});
   }
-  for (const auto& [linearIndex, value] : s.filled) {
-    const int i = static_cast<int>(linearIndex) % n, j = static_cast<int>(linearIndex) / n % n,
-              k = static_cast<int>(linearIndex) / (n * n);
-    s.accessor.setValueOff(openvdb::Coord(i, j, k), Accumulator(0.0));
-  }
-  std::sort(s.filled.begin(), s.filled.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const Impl::FilledCell& cell : s.filled)
+    s.accessor.setValueOff(cell.ijk, Accumulator(0.0));
+  std::sort(s.filled.begin(), s.filled.end(), [](const Impl::FilledCell& a, const Impl::FilledCell& b) {
+    return a.linearIndex < b.linearIndex;
+  });
 
   const double minWeight = mOptions.sampling == Sampling::kArea ? mOptions.minCellArea : 1.0;
   const double weightToCanonical = mOptions.sampling == Sampling::kArea ? cellSize * cellSize : 1.0;
@@ -338,15 +339,15 @@ Result<core::Descriptor> Describer::describe(const core::TriangleMesh& mesh,
   out.cells.reserve(s.filled.size());
   out.centroids.reserve(s.filled.size());
   out.weights.reserve(s.filled.size());
-  for (const auto& [linearIndex, value] : s.filled) {
+  for (const Impl::FilledCell& cell : s.filled) {
+    const Accumulator& value = cell.value;
     const double weight = value[0];
     if (!(weight >= minWeight) || weight <= 0.0) continue;
-    const int cell = static_cast<int>(linearIndex);
-    const Vec3 cellOrigin(cell % n, cell / n % n, cell / (n * n));
+    const Vec3 cellOrigin(cell.ijk.x(), cell.ijk.y(), cell.ijk.z());
     // Centroid in the cell's unit cube; surface outside the grid was binned into border cells.
     const Vec3 centroid =
         (Vec3(value[1], value[2], value[3]) / weight - cellOrigin).cwiseMax(0.0).cwiseMin(1.0);
-    out.cells.push_back(linearIndex);
+    out.cells.push_back(cell.linearIndex);
     out.centroids.push_back(centroid);
     out.weights.push_back(weight * weightToCanonical);
   }

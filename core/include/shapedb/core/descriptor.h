@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -32,6 +33,17 @@ struct DescriptorOptions {
   /// cell face. Keeps cells that the surface only grazes, by round-off or by a sliver, empty.
   double minCellArea = 1e-4;
 };
+
+/// Linear index i + N (j + N k) of cell (i, j, k) in an N³ grid, x fastest.
+inline std::uint32_t linearCell(int i, int j, int k, int gridSize) {
+  return static_cast<std::uint32_t>(i + gridSize * (j + gridSize * k));
+}
+
+/// The (i, j, k) of linear cell index `cell` in an N³ grid: the inverse of linearCell.
+inline std::array<int, 3> cellCoordinates(std::uint32_t cell, int gridSize) {
+  const int c = static_cast<int>(cell);
+  return {c % gridSize, c / gridSize % gridSize, c / (gridSize * gridSize)};
+}
 
 /// Largest supported grid size: N³ cell indices fit comfortably in 32 bits and a query's dense
 /// scratch in cache.
