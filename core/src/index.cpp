@@ -100,6 +100,16 @@ inline double jaccard(std::uint32_t exclusive, std::uint32_t total) {
   return total + exclusive == 0 ? 0.0 : 2.0 * exclusive / (static_cast<double>(total) + exclusive);
 }
 
+inline std::uint32_t absoluteDifference(std::uint32_t a, std::uint32_t b) {
+  return a > b ? a - b : b - a;
+}
+
+// Marks each cell's bit in the occupancy words.
+void packOccupancy(const std::vector<std::uint32_t>& cells, std::uint64_t* words) {
+  for (std::uint32_t cell : cells)
+    words[cell / 64] |= std::uint64_t{1} << (cell % 64);
+}
+
 inline bool isGrid(DescriptorKind kind) {
   return kind != DescriptorKind::kMoment;
 }
@@ -206,8 +216,7 @@ Index::Query Index::prepare(const Descriptor& d, int candidate) const {
   if (!isGrid(mOptions.kind)) return q;
   q.count = static_cast<std::uint32_t>(d.cells.size());
   q.bits.assign(mWords, 0);
-  for (std::uint32_t cell : d.cells)
-    q.bits[cell / 64] |= std::uint64_t{1} << (cell % 64);
+  packOccupancy(d.cells, q.bits.data());
   q.profile = countProfile(q.bits.data(), mOptions.gridSize);
   if (mOptions.kind == DescriptorKind::kCentroidVoxel) {
     q.dense.assign(static_cast<std::size_t>(mWords) * 64, 0);
@@ -226,16 +235,15 @@ double Index::gridDistance(const Query& q, std::size_t slot, double threshold) c
   for (std::uint32_t w = 0; w < mWords; ++w)
     exclusive += static_cast<std::uint32_t>(std::popcount(bits[w] ^ q.bits[w]));
   const std::uint32_t total = mCounts[slot] + q.count;
-  if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(exclusive, total);
-  if (total == 0) return 0.0;
+  const double mismatches = mismatchDistance(exclusive, total);
+  // Eq. (5) is the mismatches alone; for eq. (6) they may already put the entry beyond the threshold.
+  if (mOptions.kind == DescriptorKind::kVoxel || total == 0 || mismatches > threshold) return mismatches;
 
   // Eq. (6): walk the cells filled in both; an entry's centroids are stored in cell order, so a
   // cell's centroid is at the rank of its bit among the entry's bits.
   const auto value = [&](std::uint64_t terms) {
     return (static_cast<double>(exclusive) + static_cast<double>(terms) * kTermUnit) / total;
   };
-  // The mismatches alone may already put the entry beyond the threshold.
-  if (value(0) > threshold) return value(0);
   const auto& table = centroidDistanceTable();
   const std::uint16_t* centroids = &mCentroids[mCentroidBegin[slot]];
   std::uint64_t terms = 0;
@@ -265,17 +273,19 @@ double Index::gridBound(const Query& q, std::size_t slot) const {
   for (int axis = 0; axis < 3; ++axis)
     best =
         std::max(best, absoluteDifferenceSum<kProfileBins>(a + axis * kProfileBins, b + axis * kProfileBins));
-  const std::uint32_t count = mCounts[slot];
-  best = std::max(best, count > q.count ? count - q.count : q.count - count);
-  const std::uint32_t total = count + q.count;
-  if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(best, total);
-  return total == 0 ? 0.0 : static_cast<double>(best) / total;
+  best = std::max(best, absoluteDifference(mCounts[slot], q.count));
+  return mismatchDistance(best, mCounts[slot] + q.count);
 }
 
 // The bound for every entry with `count` filled cells: |count − n_q| cells are filled in one only.
 double Index::countBound(const Query& q, std::uint32_t count) const {
-  const std::uint32_t exclusive = count > q.count ? count - q.count : q.count - count;
-  const std::uint32_t total = count + q.count;
+  return mismatchDistance(absoluteDifference(count, q.count), count + q.count);
+}
+
+// The distance with `exclusive` cells filled in one grid only and no centroid term, `total` = n₁ + n₂:
+// eq. (5) itself, or eq. (6) without its centroid terms. Distances and bounds all go through it, so a
+// bound (a smaller count) never exceeds its distance in floating point.
+double Index::mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const {
   if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(exclusive, total);
   return total == 0 ? 0.0 : static_cast<double>(exclusive) / total;
 }
@@ -469,8 +479,7 @@ Status IndexBuilder::add(EntryId id, const Descriptor& d) {
   mCounts.push_back(static_cast<std::uint32_t>(d.cells.size()));
   const std::size_t base = mBits.size();
   mBits.resize(base + mWords, 0);
-  for (std::uint32_t cell : d.cells)
-    mBits[base + cell / 64] |= std::uint64_t{1} << (cell % 64);
+  packOccupancy(d.cells, &mBits[base]);
   if (mOptions.kind == DescriptorKind::kCentroidVoxel)
     for (const Vec3& c : d.centroids)
       mCentroids.push_back(quantizeCentroid(c));

@@ -101,6 +101,7 @@ class Index {
   double gridDistance(const Query& q, std::size_t slot, double threshold) const;
   double gridBound(const Query& q, std::size_t slot) const;
   double countBound(const Query& q, std::uint32_t count) const;
+  double mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const;
   void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
   void searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const;
   void searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const;
