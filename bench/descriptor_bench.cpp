@@ -33,14 +33,6 @@ using namespace shapedb;
 
 constexpr int kBaseShapes = 4500;
 
-core::DescriptorOptions optionsFor(core::DescriptorKind kind,
-                                   core::Sampling sampling = core::Sampling::kArea) {
-  core::DescriptorOptions o;
-  o.kind = kind;
-  o.sampling = sampling;
-  return o;
-}
-
 core::DescriptorKind kindOf(std::int64_t arg) {
   return static_cast<core::DescriptorKind>(arg);
 }
@@ -58,7 +50,7 @@ void BM_Describe(benchmark::State& state) {
   const auto kind = kindOf(state.range(1));
   const auto sampling = static_cast<core::Sampling>(state.range(2));
   const core::Normalization n = *core::normalize(mesh, *core::computeMassProperties(mesh));
-  volume::Describer describer(optionsFor(kind, sampling));
+  volume::Describer describer(test::descriptorOptions(kind, sampling));
   for (auto _ : state)
     benchmark::DoNotOptimize(describer.describe(mesh, n));
   state.SetLabel(std::string(core::toString(kind)) + "/" + core::toString(sampling));
@@ -84,7 +76,7 @@ const Shapes& shapes(core::DescriptorKind kind, core::Sampling sampling = core::
     std::mt19937_64 rng(1);
     for (int i = 0; i < kBaseShapes + 500; ++i) {
       Result<test::DescribedMesh> d =
-          test::describeMesh(test::makeRandomShape(rng, 2), optionsFor(kind, sampling));
+          test::describeMesh(test::makeRandomShape(rng, 2), test::descriptorOptions(kind, sampling));
       if (!d) continue;
       (slot->entries.size() < kBaseShapes ? slot->entries : slot->queries).push_back(d->descriptor);
     }
@@ -100,7 +92,7 @@ const core::Index& indexOf(core::DescriptorKind kind, std::int64_t entries,
   auto& slot = cache[{kind, entries, sampling}];
   if (!slot) {
     const Shapes& s = shapes(kind, sampling);
-    core::IndexBuilder builder(optionsFor(kind, sampling));
+    core::IndexBuilder builder(test::descriptorOptions(kind, sampling));
     std::mt19937_64 rng(2);
     std::uniform_int_distribution<int> flips(0, 6);
     for (std::int64_t i = 0; i < entries; ++i) {
@@ -194,7 +186,7 @@ void BM_DescribeAndSearch(benchmark::State& state) {
   const core::TriangleMesh mesh = test::makeLopsidedBlob({1.0, 1.6, 0.7}, 4);  // 5,120 triangles
   const core::Normalization n = *core::normalize(mesh, *core::computeMassProperties(mesh));
   const core::Index& index = indexOf(kind, kBaseShapes, sampling);
-  volume::Describer describer(optionsFor(kind, sampling));
+  volume::Describer describer(test::descriptorOptions(kind, sampling));
   std::vector<double> micros;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();

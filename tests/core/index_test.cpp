@@ -1,4 +1,5 @@
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <random>
@@ -13,25 +14,33 @@
 namespace shapedb::core {
 namespace {
 
-DescriptorOptions optionsFor(DescriptorKind kind) {
-  DescriptorOptions o;
-  o.kind = kind;
-  return o;
-}
-
 // Descriptors of `count` random shapes, the bases that jittered entries and queries are made from.
 std::vector<Descriptor> baseDescriptors(DescriptorKind kind, int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::vector<Descriptor> out;
   while (static_cast<int>(out.size()) < count) {
-    Result<test::DescribedMesh> d = test::describeMesh(test::makeRandomShape(rng, 2), optionsFor(kind));
+    Result<test::DescribedMesh> d =
+        test::describeMesh(test::makeRandomShape(rng, 2), test::descriptorOptions(kind));
     if (d) out.push_back(d->descriptor);
   }
   return out;
 }
 
+// `count` jittered copies of the bases in turn, each with flips() cells switched and centroids moved by
+// up to ±noise.
+std::vector<Descriptor> jitteredEntries(const std::vector<Descriptor>& bases, int count, std::mt19937_64& rng,
+                                        const std::function<int()>& flips, double noise) {
+  std::vector<Descriptor> entries;
+  for (int i = 0; i < count; ++i) {
+    const int f = flips();
+    entries.push_back(
+        test::jitterDescriptor(bases[static_cast<std::size_t>(i) % bases.size()], rng, f, noise));
+  }
+  return entries;
+}
+
 Index buildIndex(DescriptorKind kind, const std::vector<Descriptor>& entries) {
-  IndexBuilder builder(optionsFor(kind));
+  IndexBuilder builder(test::descriptorOptions(kind));
   for (std::size_t i = 0; i < entries.size(); ++i)
     EXPECT_TRUE(builder.add(static_cast<EntryId>(1000 + 7 * i), entries[i]).ok());
   Result<Index> index = std::move(builder).build();
@@ -61,10 +70,8 @@ void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queri
   const std::vector<Descriptor> bases = baseDescriptors(kind, 150, 42);
   std::mt19937_64 rng(99);
   std::uniform_int_distribution<int> flips(0, 10), pickBase(0, 149), pickK(1, 10), pickCandidates(1, 3);
-  std::vector<Descriptor> entries;
-  for (int i = 0; i < entryCount; ++i)
-    entries.push_back(
-        test::jitterDescriptor(bases[static_cast<std::size_t>(i % 150)], rng, flips(rng), 0.15));
+  const std::vector<Descriptor> entries = jitteredEntries(
+      bases, entryCount, rng, [&] { return flips(rng); }, 0.15);
   const Index index = buildIndex(kind, entries);
   ASSERT_EQ(index.size(), static_cast<std::size_t>(entryCount));
 
@@ -117,9 +124,8 @@ INSTANTIATE_TEST_SUITE_P(Descriptors, IndexAtScale, kKinds, kindName);
 TEST(Index, BruteForceGivesTheSameAnswerOnOneAndManyThreads) {
   const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kCentroidVoxel, 20, 3);
   std::mt19937_64 rng(4);
-  std::vector<Descriptor> entries;
-  for (int i = 0; i < 5000; ++i)
-    entries.push_back(test::jitterDescriptor(bases[static_cast<std::size_t>(i % 20)], rng, 3, 0.1));
+  const std::vector<Descriptor> entries = jitteredEntries(
+      bases, 5000, rng, [] { return 3; }, 0.1);
   const Index index = buildIndex(DescriptorKind::kCentroidVoxel, entries);
   for (int q = 0; q < 20; ++q) {
     const Descriptor query = test::jitterDescriptor(bases[static_cast<std::size_t>(q)], rng, 4, 0.1);
@@ -155,7 +161,7 @@ TEST(Index, QuantizedDistanceStaysWithinACentroidStepOfTheExactOne) {
 
 TEST(Index, TiesBreakByEntryId) {
   const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kVoxel, 1, 12);
-  IndexBuilder builder(optionsFor(DescriptorKind::kVoxel));
+  IndexBuilder builder(test::descriptorOptions(DescriptorKind::kVoxel));
   for (EntryId id : {50u, 7u, 31u, 2u, 19u})
     ASSERT_TRUE(builder.add(id, bases[0]).ok());
   Result<Index> index = std::move(builder).build();
@@ -175,9 +181,8 @@ TEST(Index, TiesBreakByEntryId) {
 TEST(Index, PaperBucketsMissWhatTheExactSearchFinds) {
   const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kCentroidVoxel, 100, 21);
   std::mt19937_64 rng(22);
-  std::vector<Descriptor> entries;
-  for (int i = 0; i < 3000; ++i)
-    entries.push_back(test::jitterDescriptor(bases[static_cast<std::size_t>(i % 100)], rng, 6, 0.15));
+  const std::vector<Descriptor> entries = jitteredEntries(
+      bases, 3000, rng, [] { return 6; }, 0.15);
   const Index index = buildIndex(DescriptorKind::kCentroidVoxel, entries);
   std::map<int, int> misses;
   const int queries = 300;
@@ -218,7 +223,7 @@ TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
   EXPECT_EQ(index.search(std::span<const Descriptor>()).error().code, ErrorCode::kInvalidArgument);
 
   // Malformed descriptors (as a corrupted file could hold) are refused, not indexed out of bounds.
-  IndexBuilder strict(optionsFor(DescriptorKind::kVoxel));
+  IndexBuilder strict(test::descriptorOptions(DescriptorKind::kVoxel));
   Descriptor bad = bases[0];
   bad.cells.push_back(1000);
   EXPECT_NE(strict.add(1, bad).error().message.find("outside the grid"), std::string::npos);
@@ -229,7 +234,7 @@ TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
   bad = bases[0];
   bad.kind = DescriptorKind::kCentroidVoxel;
   bad.centroids.pop_back();
-  IndexBuilder centroidBuilder(optionsFor(DescriptorKind::kCentroidVoxel));
+  IndexBuilder centroidBuilder(test::descriptorOptions(DescriptorKind::kCentroidVoxel));
   EXPECT_NE(centroidBuilder.add(1, bad).error().message.find("centroids for"), std::string::npos);
   bad.centroids.push_back(Vec3(0.5, 1.5, 0.5));
   EXPECT_NE(centroidBuilder.add(1, bad).error().message.find("outside its cell"), std::string::npos);
@@ -237,7 +242,7 @@ TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
   bad.moments[1] = std::nan("");
   EXPECT_NE(strict.add(1, bad).error().message.find("not finite"), std::string::npos);
 
-  IndexBuilder builder(optionsFor(DescriptorKind::kVoxel));
+  IndexBuilder builder(test::descriptorOptions(DescriptorKind::kVoxel));
   ASSERT_TRUE(builder.add(4, bases[0]).ok());
   ASSERT_TRUE(builder.add(4, bases[1]).ok());
   Result<Index> dup = std::move(builder).build();
@@ -248,7 +253,7 @@ TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
 TEST(Index, EmptyIndexFindsNothingAndSmallIndexReturnsEverything) {
   const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kMoment, 3, 31);
   for (DescriptorKind kind : {DescriptorKind::kMoment, DescriptorKind::kVoxel}) {
-    const Index empty(optionsFor(kind));
+    const Index empty(test::descriptorOptions(kind));
     Descriptor q = bases[0];
     q.kind = kind;
     if (kind == DescriptorKind::kVoxel) q.gridSize = 10;

@@ -54,6 +54,14 @@ core::TriangleMesh makeRandomShape(std::mt19937_64& rng, int subdivisions) {
   return mesh;
 }
 
+core::DescriptorOptions descriptorOptions(core::DescriptorKind kind, core::Sampling sampling, int gridSize) {
+  core::DescriptorOptions o;
+  o.kind = kind;
+  o.sampling = sampling;
+  o.gridSize = gridSize;
+  return o;
+}
+
 Result<DescribedMesh> describeMesh(const core::TriangleMesh& mesh, const core::DescriptorOptions& options) {
   Result<core::MassProperties> mp = core::computeMassProperties(mesh);
   if (!mp) return mp.error();

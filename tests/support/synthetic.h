@@ -20,6 +20,10 @@ core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions);
 /// Deterministic for a given generator state.
 core::TriangleMesh makeRandomShape(std::mt19937_64& rng, int subdivisions = 3);
 
+/// Descriptor options of the given kind, sampling and grid size.
+core::DescriptorOptions descriptorOptions(core::DescriptorKind kind,
+                                          core::Sampling sampling = core::Sampling::kArea, int gridSize = 10);
+
 /// mass properties → normalize → describe, the query pipeline up to the descriptor.
 struct DescribedMesh {
   core::Normalization normalization;

@@ -25,14 +25,6 @@ using core::Sampling;
 using core::TriangleMesh;
 using core::Vec3;
 
-DescriptorOptions optionsFor(DescriptorKind kind, Sampling sampling, int grid = 10) {
-  DescriptorOptions o;
-  o.kind = kind;
-  o.sampling = sampling;
-  o.gridSize = grid;
-  return o;
-}
-
 Descriptor describeOrDie(const TriangleMesh& mesh, const DescriptorOptions& options) {
   Result<test::DescribedMesh> d = test::describeMesh(mesh, options);
   EXPECT_TRUE(d.ok()) << (d ? "" : d.error().message);
@@ -46,7 +38,8 @@ TEST(Describe, BoxWithFacesOnCellPlanesFillsExactlyItsCells) {
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 50; ++trial) {
     const TriangleMesh mesh = trial == 0 ? box : core::transformed(box, test::randomSimilarity(rng));
-    const Descriptor d = describeOrDie(mesh, optionsFor(DescriptorKind::kCentroidVoxel, Sampling::kArea, 6));
+    const Descriptor d =
+        describeOrDie(mesh, test::descriptorOptions(DescriptorKind::kCentroidVoxel, Sampling::kArea, 6));
     std::vector<std::uint32_t> expected;
     for (int k = 2; k <= 3; ++k)
       for (int j = 1; j <= 4; ++j)
@@ -70,7 +63,8 @@ TEST(Describe, BoxWithFacesOnCellPlanesFillsExactlyItsCells) {
 
 TEST(Describe, VertexSamplingBinsTheVerticesAsThePaperDoes) {
   const TriangleMesh mesh = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 2);
-  const Descriptor d = describeOrDie(mesh, optionsFor(DescriptorKind::kVoxel, Sampling::kVertices));
+  const Descriptor d =
+      describeOrDie(mesh, test::descriptorOptions(DescriptorKind::kVoxel, Sampling::kVertices));
   double count = 0.0;
   for (double w : d.weights)
     count += w;
@@ -81,7 +75,7 @@ TEST(Describe, VertexSamplingBinsTheVerticesAsThePaperDoes) {
 TEST(Describe, MomentDescriptorIsTheCanonicalMoments) {
   const TriangleMesh mesh = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 2);
   Result<test::DescribedMesh> d =
-      test::describeMesh(mesh, optionsFor(DescriptorKind::kMoment, Sampling::kArea));
+      test::describeMesh(mesh, test::descriptorOptions(DescriptorKind::kMoment, Sampling::kArea));
   ASSERT_TRUE(d.ok());
   EXPECT_EQ(d->descriptor.moments, d->normalization.canonicalMoments);
   EXPECT_TRUE(d->descriptor.cells.empty());
@@ -91,7 +85,7 @@ TEST(Describe, RejectsOptionsOutOfRange) {
   const TriangleMesh mesh = core::makeBox(Vec3(1, 2, 3));
   for (int grid : {0, 1, core::kMaxGridSize + 1}) {
     Result<test::DescribedMesh> d =
-        test::describeMesh(mesh, optionsFor(DescriptorKind::kVoxel, Sampling::kArea, grid));
+        test::describeMesh(mesh, test::descriptorOptions(DescriptorKind::kVoxel, Sampling::kArea, grid));
     ASSERT_FALSE(d.ok());
     EXPECT_EQ(d.error().code, ErrorCode::kInvalidArgument);
     EXPECT_NE(d.error().message.find("grid size"), std::string::npos);
@@ -127,7 +121,7 @@ TEST(Describe, SameDescriptorAndSelfMatchUnderThousandRandomSimilarities) {
     for (DescriptorKind kind :
          {DescriptorKind::kMoment, DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
       SCOPED_TRACE(std::string(core::toString(kind)) + " / " + core::toString(sampling));
-      const DescriptorOptions options = optionsFor(kind, sampling);
+      const DescriptorOptions options = test::descriptorOptions(kind, sampling);
       const Descriptor reference = describeOrDie(shape, options);
       core::IndexBuilder builder(options);
       ASSERT_TRUE(builder.add(0, reference).ok());
@@ -171,7 +165,7 @@ TEST(Describe, AreaSamplingIgnoresTessellationVertexSamplingDoesNot) {
   std::map<std::string, double> figures;
   for (Sampling sampling : {Sampling::kArea, Sampling::kVertices})
     for (DescriptorKind kind : {DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
-      const DescriptorOptions options = optionsFor(kind, sampling);
+      const DescriptorOptions options = test::descriptorOptions(kind, sampling);
       const Descriptor base = describeOrDie(mesh, options);
       const std::string key = std::string(core::toString(kind)) + "/" + core::toString(sampling);
       figures[key + " finer"] = core::descriptorDistance(base, describeOrDie(finer, options));
@@ -198,7 +192,7 @@ struct OrientationFigures {
   int planeSymmetry = -1;
 };
 OrientationFigures orientationFigures(const TriangleMesh& shape, core::AxisDegeneracy expected) {
-  const DescriptorOptions options = optionsFor(DescriptorKind::kCentroidVoxel, Sampling::kArea);
+  const DescriptorOptions options = test::descriptorOptions(DescriptorKind::kCentroidVoxel, Sampling::kArea);
   const Descriptor reference = describeOrDie(shape, options);
   OrientationFigures f;
   std::mt19937_64 rng(5);
