@@ -153,8 +153,7 @@ Result<Normalization> normalize(const TriangleMesh& mesh, const MassProperties& 
     // The distinct axis d keeps its sign rule; (e1, e2, d) right-handed spans the plane, turned so that
     // the surface's strongest angular harmonic has phase 0: u' + i v' = e^{iθ}(u + i v), θ = −φ/m.
     const Vec3 d = first;
-    Vec3 e1 = pairXY ? second : y;
-    if (pairYZ) e1 = (e1 - e1.dot(d) * d).normalized();
+    Vec3 e1 = pairXY ? second : y;  // an eigenvector, orthogonal to d
     Vec3 e2 = d.cross(e1);
     const auto [order, phase] = strongestHarmonic(mesh, mp.centerOfMass, e1, e2, options.harmonicTolerance);
     if (order > 0) {
