@@ -16,3 +16,9 @@ function(shapedb_add_module name)
     $<BUILD_INTERFACE:shapedb_warnings>)
   set_target_properties(shapedb_${name} PROPERTIES OUTPUT_NAME shapedb_${name} POSITION_INDEPENDENT_CODE ON)
 endfunction()
+
+# GCC 12's AVX-512 intrinsics trip its own -Wmaybe-uninitialized wherever Eigen's packet code is inlined
+# (GCC bug 105593, fixed in GCC 13): a flood of false positives on -march=native builds only.
+if(SHAPEDB_NATIVE_ARCH AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(shapedb_warnings INTERFACE -Wno-maybe-uninitialized)
+endif()

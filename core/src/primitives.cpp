@@ -1,6 +1,7 @@
 #include <cassert>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <shapedb/core/primitives.h>
 
@@ -90,6 +91,82 @@ TriangleMesh makeCylinder(double radius, double height, int segments) {
     mesh.triangles.push_back({1, top(j), top(j + 1)});
     mesh.triangles.push_back({bottom(j), bottom(j + 1), top(j + 1)});
     mesh.triangles.push_back({bottom(j), top(j + 1), top(j)});
+  }
+  return mesh;
+}
+
+TriangleMesh makeCone(double radius, double height, int segments) {
+  assert(segments >= 3);
+  TriangleMesh mesh;
+  const double h = 0.5 * height;
+  // Base centre, apex, then the base ring.
+  mesh.vertices.emplace_back(0.0, 0.0, -h);
+  mesh.vertices.emplace_back(0.0, 0.0, h);
+  for (int j = 0; j < segments; ++j) {
+    const double phi = 2.0 * std::numbers::pi * j / segments;
+    mesh.vertices.emplace_back(radius * std::cos(phi), radius * std::sin(phi), -h);
+  }
+  const auto ring = [&](int j) { return static_cast<std::uint32_t>(2 + j % segments); };
+  for (int j = 0; j < segments; ++j) {
+    mesh.triangles.push_back({0, ring(j + 1), ring(j)});
+    mesh.triangles.push_back({ring(j), ring(j + 1), 1});
+  }
+  return mesh;
+}
+
+TriangleMesh makeCapsule(double radius, double length, int segments, int capStacks) {
+  assert(segments >= 3 && capStacks >= 1 && length >= 0.0);
+  TriangleMesh mesh;
+  const double h = 0.5 * length;
+  // Poles, then rings from the top pole down: capStacks rings on the upper hemisphere (the last on its
+  // equator at z = +h), the same mirrored below. With length 0 the two equators coincide and become one.
+  mesh.vertices.emplace_back(0.0, 0.0, h + radius);
+  mesh.vertices.emplace_back(0.0, 0.0, -h - radius);
+  std::vector<double> ringZ, ringR;
+  for (int i = 1; i <= capStacks; ++i) {
+    const double theta = 0.5 * std::numbers::pi * i / capStacks;
+    ringZ.push_back(h + radius * std::cos(theta));
+    ringR.push_back(radius * std::sin(theta));
+  }
+  for (int i = capStacks - (length > 0.0 ? 1 : 2); i >= 0; --i) {
+    ringZ.push_back(-ringZ[static_cast<std::size_t>(i)]);
+    ringR.push_back(ringR[static_cast<std::size_t>(i)]);
+  }
+  for (std::size_t i = 0; i < ringZ.size(); ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2.0 * std::numbers::pi * j / segments;
+      mesh.vertices.emplace_back(ringR[i] * std::cos(phi), ringR[i] * std::sin(phi), ringZ[i]);
+    }
+  }
+  const int rings = static_cast<int>(ringZ.size());
+  const auto ring = [&](int i, int j) { return static_cast<std::uint32_t>(2 + i * segments + j % segments); };
+  for (int j = 0; j < segments; ++j) {
+    mesh.triangles.push_back({0, ring(0, j), ring(0, j + 1)});
+    mesh.triangles.push_back({1, ring(rings - 1, j + 1), ring(rings - 1, j)});
+  }
+  for (int i = 0; i + 1 < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      mesh.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+      mesh.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+    }
+  }
+  return mesh;
+}
+
+TriangleMesh makeTriangularPrism(double base, double height, double length) {
+  TriangleMesh mesh;
+  const double b = 0.5 * base, c = 0.5 * height, h = 0.5 * length;
+  // Bottom triangle (0, 1, 2) counter-clockwise seen from +z, then the top one.
+  for (double z : {-h, h}) {
+    mesh.vertices.emplace_back(-b, -c, z);
+    mesh.vertices.emplace_back(b, -c, z);
+    mesh.vertices.emplace_back(0.0, c, z);
+  }
+  mesh.triangles = {{0, 2, 1}, {3, 4, 5}};
+  for (std::uint32_t j = 0; j < 3; ++j) {
+    const std::uint32_t k = (j + 1) % 3;
+    mesh.triangles.push_back({j, k, k + 3});
+    mesh.triangles.push_back({j, k + 3, j + 3});
   }
   return mesh;
 }

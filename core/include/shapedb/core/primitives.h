@@ -26,4 +26,16 @@ TriangleMesh makeIcosphere(double radius, int subdivisions);
 /// Circular cylinder along z, `segments` ≥ 3 around, capped by triangle fans about the cap centres.
 TriangleMesh makeCylinder(double radius, double height, int segments);
 
+/// Circular cone along z, `segments` ≥ 3 around: base of the given radius at z = −height/2, apex at
+/// z = +height/2 (the bounding box is centred, the centre of mass is not).
+TriangleMesh makeCone(double radius, double height, int segments);
+
+/// Capsule along z: a cylinder of the given radius whose axis segment has length `length` ≥ 0, closed
+/// by two hemispheres of `capStacks` ≥ 1 rings each; `segments` ≥ 3 around.
+TriangleMesh makeCapsule(double radius, double length, int segments, int capStacks);
+
+/// Right prism along z of length `length` over the isosceles triangle of base `base` (along x) and
+/// height `height` (along y), the triangle's bounding box centred on the axis. 8 triangles.
+TriangleMesh makeTriangularPrism(double base, double height, double length);
+
 }  // namespace shapedb::core

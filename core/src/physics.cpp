@@ -1,0 +1,153 @@
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <string>
+
+#include <shapedb/core/physics.h>
+
+namespace shapedb::core {
+
+double tetVolume(const TetMesh& mesh, std::size_t t) {
+  const auto& [a, b, c, d] = mesh.tets[t];
+  const Vec3& pa = mesh.nodes[a];
+  return (mesh.nodes[b] - pa).cross(mesh.nodes[c] - pa).dot(mesh.nodes[d] - pa) / 6.0;
+}
+
+Status validateTetMesh(const TetMesh& mesh) {
+  if (mesh.nodes.empty() || mesh.tets.empty()) return Error{ErrorCode::kEmptyMesh, "tet mesh has no tets"};
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : mesh.nodes) {
+    if (!p.allFinite()) return Error{ErrorCode::kNonFinite, "tet mesh has a non-finite node"};
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const std::size_t n = mesh.nodes.size();
+  // A tet far smaller than the mesh's scale is numerically flat: its stiffness would be garbage.
+  const double minVolume = 1e-15 * std::pow((hi - lo).maxCoeff(), 3);
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    for (std::uint32_t v : mesh.tets[t])
+      if (v >= n)
+        return Error{ErrorCode::kIndexOutOfRange, "tet " + std::to_string(t) + " refers to node " +
+                                                      std::to_string(v) + " of " + std::to_string(n)};
+    if (!(tetVolume(mesh, t) > minVolume))
+      return Error{ErrorCode::kDegenerateFace, "tet " + std::to_string(t) + " is flat or inverted"};
+  }
+  return Ok{};
+}
+
+MassProperties computeTetMassProperties(const TetMesh& mesh, double density) {
+  // Integrals about a reference point inside the mesh's span, for round-off.
+  Vec3 ref = Vec3::Zero();
+  for (const Vec3& p : mesh.nodes)
+    ref += p;
+  ref /= static_cast<double>(mesh.nodes.size());
+
+  double volume = 0.0;
+  Vec3 first = Vec3::Zero();   // ∫ x dV
+  Mat3 second = Mat3::Zero();  // ∫ x xᵀ dV
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    const auto& tet = mesh.tets[t];
+    const double v = tetVolume(mesh, t);
+    Vec3 sum = Vec3::Zero();
+    Mat3 outer = Mat3::Zero();
+    for (std::uint32_t i : tet) {
+      const Vec3 p = mesh.nodes[i] - ref;
+      sum += p;
+      outer += p * p.transpose();
+    }
+    // Over a tet: ∫ x dV = V Σp/4, ∫ x xᵀ dV = V (Σ p pᵀ + Σp Σpᵀ) / 20.
+    volume += v;
+    first += v * sum / 4.0;
+    second += v * (outer + sum * sum.transpose()) / 20.0;
+  }
+  MassProperties result;
+  result.density = density;
+  result.volume = volume;
+  result.mass = density * volume;
+  const Vec3 c = first / volume;
+  result.centerOfMass = ref + c;
+  result.inertia = inertiaFromCovariance(density * (second - volume * c * c.transpose()));
+  return result;
+}
+
+TriangleMesh boundarySurface(const TetMesh& mesh) {
+  // A face seen by one tet only is on the boundary. Faces of a positively oriented tet (a, b, c, d),
+  // wound outward: (a, c, b), (a, b, d), (b, c, d), (a, d, c).
+  std::map<std::array<std::uint32_t, 3>, std::pair<std::array<std::uint32_t, 3>, int>> faces;
+  for (const auto& [a, b, c, d] : mesh.tets) {
+    for (const std::array<std::uint32_t, 3>& f :
+         {std::array{a, c, b}, std::array{a, b, d}, std::array{b, c, d}, std::array{a, d, c}}) {
+      std::array<std::uint32_t, 3> key = f;
+      std::sort(key.begin(), key.end());
+      auto [it, inserted] = faces.try_emplace(key, f, 0);
+      ++it->second.second;
+    }
+  }
+  TriangleMesh surface;
+  std::vector<std::uint32_t> remap(mesh.nodes.size(), UINT32_MAX);
+  for (const auto& [key, face] : faces) {
+    if (face.second != 1) continue;
+    TriangleMesh::Triangle triangle;
+    for (int i = 0; i < 3; ++i) {
+      std::uint32_t& r = remap[face.first[static_cast<std::size_t>(i)]];
+      if (r == UINT32_MAX) {
+        r = static_cast<std::uint32_t>(surface.vertices.size());
+        surface.vertices.push_back(mesh.nodes[face.first[static_cast<std::size_t>(i)]]);
+      }
+      triangle[static_cast<std::size_t>(i)] = r;
+    }
+    surface.triangles.push_back(triangle);
+  }
+  return surface;
+}
+
+Eigen::VectorXd ModalData::frequenciesHz() const {
+  Eigen::VectorXd hz(eigenvalues.size());
+  for (Eigen::Index i = 0; i < eigenvalues.size(); ++i)
+    hz[i] = std::sqrt(std::max(eigenvalues[i], 0.0)) / (2.0 * std::numbers::pi);
+  return hz;
+}
+
+bool CollisionShape::contains(const Vec3& p) const {
+  const Vec3 local = rotation.transpose() * (p - center);
+  switch (type) {
+    case Type::kSphere:
+      return local.squaredNorm() <= radius * radius;
+    case Type::kBox:
+      return (local.cwiseAbs() - halfExtents).maxCoeff() <= 0.0;
+    case Type::kCapsule: {
+      const double z = std::clamp(local.z(), -halfLength, halfLength);
+      return (local - Vec3(0.0, 0.0, z)).squaredNorm() <= radius * radius;
+    }
+  }
+  return false;
+}
+
+double CollisionShape::volume() const {
+  const double ball = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+  switch (type) {
+    case Type::kSphere:
+      return ball;
+    case Type::kBox:
+      return 8.0 * halfExtents.prod();
+    case Type::kCapsule:
+      return ball + std::numbers::pi * radius * radius * 2.0 * halfLength;
+  }
+  return 0.0;
+}
+
+const char* toString(CollisionShape::Type type) {
+  switch (type) {
+    case CollisionShape::Type::kSphere:
+      return "sphere";
+    case CollisionShape::Type::kBox:
+      return "box";
+    case CollisionShape::Type::kCapsule:
+      return "capsule";
+  }
+  return "?";
+}
+
+}  // namespace shapedb::core

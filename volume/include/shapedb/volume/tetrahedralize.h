@@ -1,0 +1,41 @@
+#pragma once
+
+#include <string>
+
+#include <shapedb/core/physics.h>
+#include <shapedb/core/result.h>
+#include <shapedb/core/triangle_mesh.h>
+
+namespace shapedb::volume {
+
+/// TetGen's quality switches (its manual, §4.2) and how to run it.
+struct TetrahedralizeOptions {
+  /// Maximum radius-edge ratio of a tet ('q'); TetGen refines until every tet meets it. ≥ 1.1.
+  double maxRadiusEdgeRatio = 1.5;
+  /// Maximum tet volume ('a') as a fraction of the solid's volume: about 1/maxVolumeFraction tets at
+  /// least. 0: no volume bound.
+  double maxVolumeFraction = 1.0 / 600.0;
+  /// Run TetGen in a child process, so that a crash or a hang in it (TetGen 1.5 segfaults on some bad
+  /// input and aborts on others) becomes an error instead of taking the caller down. Off only for meshes
+  /// the caller made itself and for measuring the cost of the guard.
+  bool guarded = true;
+  /// Guarded only: the child is killed after this long and the call fails.
+  double timeoutSeconds = 120.0;
+};
+
+/// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like.
+std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume);
+
+/// A quality tetrahedral mesh of the solid bounded by `surface` (TetGen: a constrained Delaunay
+/// tetrahedralization of the surface as a piecewise linear complex, refined to the quality bounds). The
+/// tets fill the surface exactly: their boundary lies on the input faces, so their volume integrals
+/// equal the surface integrals to round-off.
+///
+/// The input is validated first (finite, indices in range, no degenerate face, closed, consistently and
+/// outward oriented, positive volume): TetGen is never handed a mesh it is known to choke on. Errors: the
+/// validation's, kParse if TetGen refuses the input (self-intersections, say), kIo if the guarded child
+/// crashed or timed out (the message says which signal). Thread-safe.
+Result<core::TetMesh> tetrahedralize(const core::TriangleMesh& surface,
+                                     const TetrahedralizeOptions& options = {});
+
+}  // namespace shapedb::volume
