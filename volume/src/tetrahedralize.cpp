@@ -100,9 +100,14 @@ Result<RawResult> runTetGenGuarded(const TriangleMesh& surface, const std::strin
   }
   if (pid == 0) {
     ::close(fds[0]);
-    // TetGen prints nothing with 'Q', but a crash report must not interleave with the parent's output.
-    std::FILE* devnull = std::freopen("/dev/null", "w", stdout);
-    (void)devnull;
+    // TetGen prints nothing with 'Q'; anything it or a crash report writes goes to /dev/null. The file
+    // descriptors are redirected, not the FILE streams: closing or flushing the inherited stdout would
+    // write the parent's pending output a second time.
+    const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (devnull >= 0) {
+      ::dup2(devnull, STDOUT_FILENO);
+      ::dup2(devnull, STDERR_FILENO);
+    }
     const RawResult raw = runTetGen(surface, switches);
     const std::int64_t header[3] = {raw.status, static_cast<std::int64_t>(raw.nodes.size()),
                                     static_cast<std::int64_t>(raw.tets.size())};

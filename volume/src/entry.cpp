@@ -1,0 +1,80 @@
+#include <chrono>
+#include <cmath>
+
+#include <shapedb/volume/describe.h>
+#include <shapedb/volume/entry.h>
+
+namespace shapedb::volume {
+namespace {
+
+class Stopwatch {
+ public:
+  /// Seconds since the last call (or construction).
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - mLast).count();
+    mLast = now;
+    return seconds;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point mLast = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOptions& options) {
+  EntryData entry;
+  Stopwatch clock;
+  if (Status valid = core::validateMesh(surface); !valid) return valid.error();
+  auto mass = core::computeMassProperties(surface);
+  if (!mass) return mass.error();
+  entry.surfaceMassProperties = *mass;
+  auto normalization = core::normalize(surface, *mass);
+  if (!normalization) return withContext(normalization.error(), "normalize");
+  entry.normalization = *normalization;
+  const core::TriangleMesh canonical = core::transformed(surface, normalization->canonicalFromMesh);
+  entry.times.normalize = clock.lap();
+
+  auto tets = tetrahedralize(canonical, options.tetgen);
+  if (!tets) return withContext(tets.error(), "tetrahedralize");
+  entry.physics.tetMesh = std::move(tets).value();
+  entry.physics.massProperties = core::computeTetMassProperties(entry.physics.tetMesh);
+  // The tets must fill the surface: unit volume, centre at the origin, in the canonical frame.
+  const core::MassProperties& m = entry.physics.massProperties;
+  if (std::abs(m.volume - 1.0) > 1e-9 || m.centerOfMass.norm() > 1e-9)
+    return Error{ErrorCode::kParse, "tetrahedralize: the tet mesh does not fill the surface (volume " +
+                                        std::to_string(m.volume) + " of 1)"};
+  entry.times.tetrahedralize = clock.lap();
+
+  Describer describer(options.descriptor);
+  for (core::DescriptorKind kind :
+       {core::DescriptorKind::kMoment, core::DescriptorKind::kVoxel, core::DescriptorKind::kCentroidVoxel}) {
+    core::DescriptorOptions o = options.descriptor;
+    o.kind = kind;
+    auto d = kind == options.descriptor.kind ? describer.describe(surface, *normalization)
+                                             : volume::describe(surface, *normalization, o);
+    if (!d) return withContext(d.error(), "describe");
+    entry.descriptors[static_cast<std::size_t>(kind)] = std::move(d).value();
+  }
+  entry.times.describe = clock.lap();
+
+  ModalOptions modal = options.modal;
+  modal.material = {
+      .youngsModulus = 1.0, .poissonRatio = options.modal.material.poissonRatio, .density = 1.0};
+  auto modes = computeModes(entry.physics.tetMesh, modal);
+  if (!modes) return withContext(modes.error(), "modes");
+  entry.physics.modes = std::move(modes).value();
+  entry.times.modes = clock.lap();
+
+  auto collision = fitCollisionCompound(canonical, options.collision);
+  if (!collision) return withContext(collision.error(), "collision");
+  entry.physics.collision = std::move(collision).value();
+  entry.times.collision = clock.lap();
+
+  entry.physics.sound.frequenciesHz = entry.physics.modes.frequenciesHz();
+  entry.physics.sound.damping = options.damping;
+  return entry;
+}
+
+}  // namespace shapedb::volume
