@@ -24,6 +24,9 @@ struct Command {
 
 Command addInspectCommand(CLI::App& parent);
 Command addDescribeCommand(CLI::App& parent);
+Command addBuildCommand(CLI::App& parent);
+Command addInfoCommand(CLI::App& parent);
+Command addAddCommand(CLI::App& parent);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);

@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("shapedb " SHAPEDB_VERSION " (OpenVDB ") +
                                         shapedb::volume::openVdbVersion() + ")");
   app.require_subcommand(1);
-  std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app)};
+  std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
+                                   addInfoCommand(app), addAddCommand(app)};
 
   try {
     app.parse(argc, argv);

@@ -172,6 +172,10 @@ TEST(Tetrahedralize, BadInputIsAnErrorNotACrash) {
   r = tetrahedralize(overlap);
   ASSERT_FALSE(r.ok());
   std::printf("self-intersecting: %s\n", r.error().message.c_str());
+
+  // The worker that crashed is replaced: the next mesh tetrahedralizes as before.
+  const TetMesh after = tetsOrDie(core::makeBox(Vec3(1, 2, 3)));
+  EXPECT_NEAR(core::computeTetMassProperties(after).volume, 6.0, 1e-12);
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -8,6 +9,8 @@
 #include <poll.h>
 #include <signal.h>
 #include <string>
+#include <sys/socket.h>
+#include <sys/syscall.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -74,10 +77,11 @@ RawResult runTetGen(const TriangleMesh& surface, const std::string& switches) {
   return result;
 }
 
-bool writeAll(int fd, const void* data, std::size_t bytes) {
+/// Sends all bytes on a socket; MSG_NOSIGNAL: a dead peer is an error, not a SIGPIPE.
+bool sendAll(int fd, const void* data, std::size_t bytes) {
   const char* p = static_cast<const char*>(data);
   while (bytes > 0) {
-    const ssize_t n = ::write(fd, p, bytes);
+    const ssize_t n = ::send(fd, p, bytes, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
     p += n;
@@ -86,85 +90,155 @@ bool writeAll(int fd, const void* data, std::size_t bytes) {
   return true;
 }
 
-/// Runs TetGen in a forked child that writes its RawResult into a pipe: status, node count, tet count,
-/// then the arrays. A crash in the child is a signal the parent reports, not a crash of the parent.
-Result<RawResult> runTetGenGuarded(const TriangleMesh& surface, const std::string& switches, double timeout) {
-  int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0)
-    return Error{ErrorCode::kIo, std::string("pipe: ") + std::strerror(errno)};
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    ::close(fds[0]);
-    ::close(fds[1]);
-    return Error{ErrorCode::kIo, std::string("fork: ") + std::strerror(errno)};
-  }
-  if (pid == 0) {
-    ::close(fds[0]);
-    // TetGen prints nothing with 'Q'; anything it or a crash report writes goes to /dev/null. The file
-    // descriptors are redirected, not the FILE streams: closing or flushing the inherited stdout would
-    // write the parent's pending output a second time.
-    const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (devnull >= 0) {
-      ::dup2(devnull, STDOUT_FILENO);
-      ::dup2(devnull, STDERR_FILENO);
-    }
-    const RawResult raw = runTetGen(surface, switches);
-    const std::int64_t header[3] = {raw.status, static_cast<std::int64_t>(raw.nodes.size()),
-                                    static_cast<std::int64_t>(raw.tets.size())};
-    const bool ok = writeAll(fds[1], header, sizeof header) &&
-                    writeAll(fds[1], raw.nodes.data(), raw.nodes.size() * sizeof(double)) &&
-                    writeAll(fds[1], raw.tets.data(), raw.tets.size() * sizeof(std::int32_t));
-    ::_exit(ok ? 0 : 1);  // no destructors, no atexit handlers of the parent's libraries
-  }
-  ::close(fds[1]);
+using Deadline = std::chrono::steady_clock::time_point;
 
-  std::vector<char> bytes;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
-  bool timedOut = false;
-  char buffer[1 << 16];
-  for (;;) {
+/// Receives exactly `bytes`, waiting until the deadline. False on end of stream, error or timeout.
+bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline, bool& timedOut) {
+  char* p = static_cast<char*>(data);
+  while (bytes > 0) {
     const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) {
-      timedOut = true;
-      break;
-    }
-    pollfd pfd{fds[0], POLLIN, 0};
-    const int ready = ::poll(&pfd, 1, static_cast<int>(left.count()));
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready == 0) continue;  // the deadline check above ends the wait
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now())
+            .count();
+    if (left <= 0) return !(timedOut = true);
+    pollfd pfd{fd, POLLIN, 0};
+    const int ready = ::poll(&pfd, 1, static_cast<int>(std::min<long long>(left, 1000)));
+    if (ready < 0 && errno != EINTR) return false;
+    if (ready <= 0) continue;
+    const ssize_t n = ::recv(fd, p, bytes, 0);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    bytes.insert(bytes.end(), buffer, buffer + n);
+    if (n <= 0) return false;
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
   }
-  ::close(fds[0]);
-  if (timedOut) ::kill(pid, SIGKILL);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (timedOut)
-    return Error{ErrorCode::kIo,
-                 "TetGen did not finish within " + std::to_string(static_cast<int>(timeout)) + " s"};
-  if (WIFSIGNALED(status))
-    return Error{ErrorCode::kIo, std::string("TetGen crashed (") + ::strsignal(WTERMSIG(status)) + ")"};
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return Error{ErrorCode::kIo, "TetGen's process failed"};
+  return true;
+}
 
-  std::int64_t header[3];
-  if (bytes.size() < sizeof header) return Error{ErrorCode::kIo, "TetGen's process returned no result"};
-  std::memcpy(header, bytes.data(), sizeof header);
-  RawResult raw;
-  raw.status = static_cast<std::int32_t>(header[0]);
-  const auto nodeValues = static_cast<std::size_t>(header[1]);
-  const auto tetValues = static_cast<std::size_t>(header[2]);
-  if (bytes.size() != sizeof header + nodeValues * sizeof(double) + tetValues * sizeof(std::int32_t))
-    return Error{ErrorCode::kIo, "TetGen's process returned a truncated result"};
-  raw.nodes.resize(nodeValues);
-  raw.tets.resize(tetValues);
-  std::memcpy(raw.nodes.data(), bytes.data() + sizeof header, nodeValues * sizeof(double));
-  std::memcpy(raw.tets.data(), bytes.data() + sizeof header + nodeValues * sizeof(double),
-              tetValues * sizeof(std::int32_t));
-  return raw;
+/// The child's side: requests in (switches, vertices, triangles), RawResults out, until the parent
+/// closes the socket. Never returns.
+[[noreturn]] void serveTetGen(int fd) {
+  const Deadline never = std::chrono::steady_clock::time_point::max();
+  for (;;) {
+    bool timedOut = false;
+    std::uint64_t header[3];  // switches length, vertex count, triangle count
+    if (!receiveAll(fd, header, sizeof header, never, timedOut)) ::_exit(0);
+    std::string switches(header[0], '\0');
+    TriangleMesh surface;
+    surface.vertices.resize(header[1]);
+    surface.triangles.resize(header[2]);
+    if (!receiveAll(fd, switches.data(), switches.size(), never, timedOut) ||
+        !receiveAll(fd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3), never,
+                    timedOut) ||
+        !receiveAll(fd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle),
+                    never, timedOut))
+      ::_exit(1);
+    const RawResult raw = runTetGen(surface, switches);
+    const std::int64_t reply[3] = {raw.status, static_cast<std::int64_t>(raw.nodes.size()),
+                                   static_cast<std::int64_t>(raw.tets.size())};
+    if (!sendAll(fd, reply, sizeof reply) ||
+        !sendAll(fd, raw.nodes.data(), raw.nodes.size() * sizeof(double)) ||
+        !sendAll(fd, raw.tets.data(), raw.tets.size() * sizeof(std::int32_t)))
+      ::_exit(1);
+  }
+}
+
+/// A child process that runs TetGen for one thread of the parent, request after request. Forked once and
+/// reused: a fork per call costs more than TetGen itself on small meshes (the parent's pages turn
+/// copy-on-write at every fork, and every later write to them faults). A crash or a hang in the child
+/// costs that one request: the child is reaped and the next request forks a fresh one.
+class TetGenWorker {
+ public:
+  ~TetGenWorker() { stop(); }
+
+  Result<RawResult> run(const TriangleMesh& surface, const std::string& switches, double timeout) {
+    if (mPid <= 0)
+      if (Status st = start(); !st) return st.error();
+    const Deadline deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                               std::chrono::duration<double>(timeout));
+    const std::uint64_t header[3] = {switches.size(), surface.vertices.size(), surface.triangles.size()};
+    bool timedOut = false;
+    std::int64_t reply[3] = {0, 0, 0};
+    bool ok =
+        sendAll(mFd, header, sizeof header) && sendAll(mFd, switches.data(), switches.size()) &&
+        sendAll(mFd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3)) &&
+        sendAll(mFd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle)) &&
+        receiveAll(mFd, reply, sizeof reply, deadline, timedOut);
+    RawResult raw;
+    if (ok && reply[1] >= 0 && reply[2] >= 0 && reply[1] < (std::int64_t{1} << 34) &&
+        reply[2] < (std::int64_t{1} << 34)) {
+      raw.status = static_cast<std::int32_t>(reply[0]);
+      raw.nodes.resize(static_cast<std::size_t>(reply[1]));
+      raw.tets.resize(static_cast<std::size_t>(reply[2]));
+      ok = receiveAll(mFd, raw.nodes.data(), raw.nodes.size() * sizeof(double), deadline, timedOut) &&
+           receiveAll(mFd, raw.tets.data(), raw.tets.size() * sizeof(std::int32_t), deadline, timedOut);
+    } else {
+      ok = false;
+    }
+    if (ok) return raw;
+    // The child died or hung on this input: reap it, say why, and start afresh next time.
+    const int status = stop();
+    if (timedOut)
+      return Error{ErrorCode::kIo,
+                   "TetGen did not finish within " + std::to_string(static_cast<int>(timeout)) + " s"};
+    if (WIFSIGNALED(status))
+      return Error{ErrorCode::kIo, std::string("TetGen crashed (") + ::strsignal(WTERMSIG(status)) + ")"};
+    return Error{ErrorCode::kIo, "TetGen's process failed"};
+  }
+
+ private:
+  Status start() {
+    int fds[2];
+    if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
+      return Error{ErrorCode::kIo, std::string("socketpair: ") + std::strerror(errno)};
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+      ::close(fds[0]);
+      ::close(fds[1]);
+      return Error{ErrorCode::kIo, std::string("fork: ") + std::strerror(errno)};
+    }
+    if (pid == 0) {
+      ::close(fds[0]);
+      // TetGen prints nothing with 'Q'; anything it or a crash report writes goes to /dev/null. The file
+      // descriptors are redirected, not the FILE streams: flushing the inherited stdout would write the
+      // parent's pending output a second time.
+      const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+      if (devnull >= 0) {
+        ::dup2(devnull, STDOUT_FILENO);
+        ::dup2(devnull, STDERR_FILENO);
+      }
+      // Keep the socket and stdio only: a descriptor inherited from the parent (another worker's socket,
+      // the database file) must not outlive the parent's own copy, or that worker never sees end of stream.
+      ::dup2(fds[1], 3);
+      ::syscall(SYS_close_range, 4u, ~0u, 0u);
+      serveTetGen(3);
+    }
+    ::close(fds[1]);
+    mFd = fds[0];
+    mPid = pid;
+    return Ok{};
+  }
+
+  /// Closes the socket, kills the child (idle, or already failed: nothing to lose) and reaps it; returns
+  /// its wait status, which says how it died if it died first.
+  int stop() {
+    int status = 0;
+    if (mFd >= 0) ::close(mFd);
+    if (mPid > 0) ::kill(mPid, SIGKILL);
+    if (mPid > 0)
+      while (::waitpid(mPid, &status, 0) < 0 && errno == EINTR) {
+      }
+    mFd = -1;
+    mPid = -1;
+    return status;
+  }
+
+  pid_t mPid = -1;
+  int mFd = -1;
+};
+
+Result<RawResult> runTetGenGuarded(const TriangleMesh& surface, const std::string& switches, double timeout) {
+  thread_local TetGenWorker worker;
+  return worker.run(surface, switches, timeout);
 }
 
 /// TetGen's error codes (terminatetetgen in tetgen.cxx).

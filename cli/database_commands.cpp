@@ -1,0 +1,311 @@
+// shapedb build, info, add: the database file's subcommands.
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <shapedb/io/database.h>
+#include <shapedb/io/mesh_io.h>
+#include <shapedb/volume/describe.h>
+#include <shapedb/volume/families.h>
+
+#include "commands.h"
+
+namespace shapedb::cli {
+namespace {
+
+std::string formatDuration(double seconds) {
+  char buffer[32];
+  const long s = std::lround(seconds);
+  if (s >= 3600)
+    std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", s / 3600, (s / 60) % 60);
+  else if (s >= 60)
+    std::snprintf(buffer, sizeof buffer, "%ldm%02lds", s / 60, s % 60);
+  else
+    std::snprintf(buffer, sizeof buffer, "%.1fs", seconds);
+  return buffer;
+}
+
+/// A progress bar with ETA on a terminal (redrawn in place on stderr), plain lines every 5 % otherwise.
+class ProgressPrinter {
+ public:
+  ProgressPrinter() : mTerminal(::isatty(STDERR_FILENO) != 0) {}
+  void operator()(const io::BuildProgress& p) {
+    const double fraction = p.total ? static_cast<double>(p.done) / static_cast<double>(p.total) : 1.0;
+    const double eta =
+        p.done ? p.elapsedSeconds * static_cast<double>(p.total - p.done) / static_cast<double>(p.done) : 0.0;
+    const double rate = p.elapsedSeconds > 0 ? static_cast<double>(p.done) / p.elapsedSeconds : 0.0;
+    if (mTerminal) {
+      const int width = 30, filled = static_cast<int>(fraction * width);
+      std::fprintf(stderr, "\r[%s%s] %zu/%zu %5.1f%%  %.1f entries/s  ETA %s  %s   ",
+                   std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                   std::string(static_cast<std::size_t>(width - filled), '.').c_str(), p.done, p.total,
+                   100.0 * fraction, rate, formatDuration(eta).c_str(), p.lastName.c_str());
+      if (p.done == p.total) std::fprintf(stderr, "\n");
+    } else {
+      const int step = static_cast<int>(fraction * 20.0);
+      if (step == mLastStep && p.done != p.total) return;
+      mLastStep = step;
+      std::fprintf(stderr, "build: %zu/%zu entries (%.0f%%), %zu failed, %.1f entries/s, ETA %s\n", p.done,
+                   p.total, 100.0 * fraction, p.failed, rate, formatDuration(eta).c_str());
+    }
+    std::fflush(stderr);
+  }
+
+ private:
+  bool mTerminal;
+  int mLastStep = -1;
+};
+
+struct BuildCommandOptions {
+  std::string path;
+  std::size_t entries = 4500;
+  std::string families = "all";
+  int modes = 20;
+  int threads = 0;
+  int grid = 10;
+  std::string sampling = "area";
+  double poisson = 0.3;
+  std::size_t batch = 16;
+  bool resume = false;
+  bool quiet = false;
+};
+
+int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
+  io::BuildOptions options;
+  options.threads = o.threads;
+  options.batchSize = o.batch;
+  options.resume = o.resume;
+  io::BuildParameters& p = options.parameters;
+  p.entries = o.entries;
+  auto families = volume::parseFamilies(o.families);
+  if (!families) {
+    printError(families.error().message);
+    return kExitUsage;
+  }
+  p.families = std::move(families).value();
+  p.entry.modal.modes = o.modes;
+  p.entry.modal.material.poissonRatio = o.poisson;
+  p.entry.descriptor.gridSize = o.grid;
+  p.entry.descriptor.sampling = *core::parseSampling(o.sampling);
+
+  if (o.resume) {
+    // A resumed build continues with the file's own parameters; one given here that differs is an error.
+    auto store = io::Store::open(o.path);
+    if (!store) {
+      printError(store.error().message);
+      return kExitInputError;
+    }
+    const io::BuildParameters& have = store->parameters();
+    std::string conflict;
+    const auto check = [&](const char* flag, bool differs) {
+      if (app.count(flag) && differs && conflict.empty()) conflict = flag;
+    };
+    check("--entries", have.entries != p.entries);
+    check("--families", have.families != p.families);
+    check("--modes", have.entry.modal.modes != p.entry.modal.modes);
+    check("--grid", have.entry.descriptor.gridSize != p.entry.descriptor.gridSize);
+    check("--sampling", have.entry.descriptor.sampling != p.entry.descriptor.sampling);
+    check("--poisson", have.entry.modal.material.poissonRatio != p.entry.modal.material.poissonRatio);
+    if (!conflict.empty()) {
+      printError(o.path + ": was built with another " + conflict.substr(2) +
+                 " (its parameters: " + io::toJson(have) + "); a resumed build keeps them");
+      return kExitUsage;
+    }
+  }
+  ProgressPrinter printer;
+  if (!o.quiet) options.progress = [&printer](const io::BuildProgress& progress) { printer(progress); };
+  auto report = io::buildDatabase(o.path, options);
+  if (!report) {
+    printError(report.error().message);
+    return report.error().code == ErrorCode::kInvalidArgument ? kExitUsage : kExitInputError;
+  }
+  const volume::StageTimes& t = report->stageSeconds;
+  const double built = static_cast<double>(std::max<std::size_t>(1, report->built));
+  std::printf("%s: %zu entries built, %zu failed, %zu already there, in %s (%.1f entries/s)\n",
+              o.path.c_str(), report->built, report->failed, report->skipped,
+              formatDuration(report->seconds).c_str(),
+              static_cast<double>(report->built) / std::max(1e-9, report->seconds));
+  std::printf(
+      "per entry: tetrahedralize %.0f ms, modes %.0f ms, collision %.0f ms, describe %.0f ms, normalize %.2f "
+      "ms\n",
+      1e3 * t.tetrahedralize / built, 1e3 * t.modes / built, 1e3 * t.collision / built,
+      1e3 * t.describe / built, 1e3 * t.normalize / built);
+  if (report->failed) std::printf("see 'shapedb info %s' for the failures\n", o.path.c_str());
+  return kExitOk;
+}
+
+struct InfoOptions {
+  std::string path;
+  bool json = false;
+};
+
+int runInfo(const InfoOptions& o) {
+  auto store = io::Store::open(o.path);
+  if (!store) {
+    printError(store.error().message);
+    return kExitInputError;
+  }
+  auto entries = store->entries();
+  auto failures = store->failures();
+  if (!entries || !failures) {
+    printError((entries ? failures.error() : entries.error()).message);
+    return kExitInputError;
+  }
+  std::map<std::string, std::size_t> perFamily;
+  std::size_t nodes = 0, tets = 0;
+  for (const io::EntryRecord& r : *entries) {
+    ++perFamily[volume::toString(r.family)];
+    nodes += r.nodes;
+    tets += r.tets;
+  }
+  std::error_code ec;
+  std::uintmax_t bytes = std::filesystem::file_size(o.path, ec);
+  const std::filesystem::path wal = o.path + "-wal";
+  if (std::filesystem::exists(wal, ec)) bytes += std::filesystem::file_size(wal, ec);
+  const double buildSeconds = std::stod(store->meta("build_seconds").value_or("0"));
+  const std::string status = store->meta("status").value_or("unknown");
+  const std::size_t n = entries->size();
+
+  nlohmann::json families = nlohmann::json::object();
+  for (const auto& [family, count] : perFamily)
+    families[family] = count;
+  nlohmann::json failed = nlohmann::json::array();
+  for (const io::FailureRecord& f : *failures)
+    failed.push_back({{"name", f.name}, {"message", f.message}});
+  if (o.json) {
+    const nlohmann::json out = {
+        {"file", o.path},
+        {"schema_version", io::kSchemaVersion},
+        {"status", status},
+        {"created", store->meta("created").value_or("")},
+        {"entries", n},
+        {"families", families},
+        {"failures", failed},
+        {"parameters", nlohmann::json::parse(io::toJson(store->parameters()))},
+        {"size_bytes", bytes},
+        {"bytes_per_entry", n ? static_cast<double>(bytes) / static_cast<double>(n) : 0.0},
+        {"build_seconds", buildSeconds},
+        {"mean_nodes", n ? static_cast<double>(nodes) / static_cast<double>(n) : 0.0},
+        {"mean_tets", n ? static_cast<double>(tets) / static_cast<double>(n) : 0.0}};
+    std::printf("%s\n", out.dump(2).c_str());
+    return kExitOk;
+  }
+  const io::BuildParameters& p = store->parameters();
+  std::printf("%s: shapedb database, schema %d, %s, created %s\n", o.path.c_str(), io::kSchemaVersion,
+              status.c_str(), store->meta("created").value_or("?").c_str());
+  std::printf("entries: %zu", n);
+  for (const auto& [family, count] : perFamily)
+    std::printf("  %s %zu", family.c_str(), count);
+  std::printf("\nfailed: %zu\n", failures->size());
+  for (std::size_t i = 0; i < failures->size() && i < 10; ++i)
+    std::printf("  %s: %s\n", (*failures)[i].name.c_str(), (*failures)[i].message.c_str());
+  std::printf("size on disk: %.1f MiB (%.1f KiB per entry)\n", static_cast<double>(bytes) / 1048576.0,
+              n ? static_cast<double>(bytes) / 1024.0 / static_cast<double>(n) : 0.0);
+  std::printf("build time: %s\n", formatDuration(buildSeconds).c_str());
+  std::printf("tet meshes: %.0f nodes, %.0f tets on average\n",
+              n ? static_cast<double>(nodes) / static_cast<double>(n) : 0.0,
+              n ? static_cast<double>(tets) / static_cast<double>(n) : 0.0);
+  std::printf(
+      "parameters: catalog of %zu, descriptor grid %d (%s sampling), %d modes at Poisson ratio %.3g,\n"
+      "  TetGen q%.3g with tets ≤ 1/%.0f of the volume, collision ≤ %d shapes, Rayleigh α %.3g β %.3g\n",
+      p.entries, p.entry.descriptor.gridSize, core::toString(p.entry.descriptor.sampling),
+      p.entry.modal.modes, p.entry.modal.material.poissonRatio, p.entry.tetgen.maxRadiusEdgeRatio,
+      p.entry.tetgen.maxVolumeFraction > 0 ? 1.0 / p.entry.tetgen.maxVolumeFraction : 0.0,
+      p.entry.collision.maxShapes, p.entry.damping.alpha, p.entry.damping.beta);
+  return kExitOk;
+}
+
+struct AddOptions {
+  std::string path;
+  std::vector<std::string> meshes;
+};
+
+int runAdd(const AddOptions& o) {
+  std::vector<io::NamedMesh> meshes;
+  for (const std::string& file : o.meshes) {
+    auto loaded = io::loadMesh(file);
+    if (!loaded) {
+      printError(loaded.error().message);
+      return kExitInputError;
+    }
+    meshes.push_back({std::filesystem::path(file).filename().string(), file, std::move(loaded->mesh)});
+  }
+  auto ids = io::addToDatabase(o.path, meshes);
+  if (!ids) {
+    printError(ids.error().message);
+    return kExitInputError;
+  }
+  for (std::size_t i = 0; i < ids->size(); ++i)
+    std::printf("%s: added as entry %u '%s'\n", meshes[i].source.c_str(), (*ids)[i], meshes[i].name.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command addBuildCommand(CLI::App& parent) {
+  auto o = std::make_shared<BuildCommandOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "build",
+      "Build a shape database (paper §3.1) into one SQLite file: for each shape of the families' sweeps, a\n"
+      "TetGen tet mesh, mass properties, the three descriptors, the first M vibration modes (linear FEM,\n"
+      "unit density and Young's modulus), a collision compound and sound data. Runs on all cores; commits\n"
+      "every --batch entries, so an interrupted build loses little: continue it with --resume.");
+  app->add_option("DB", o->path, "Database file to create (or to continue, with --resume)")->required();
+  app->add_option("--entries", o->entries, "Entries in the catalog, spread evenly over the families")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{1}, std::size_t{10'000'000}));
+  app->add_option("--families", o->families,
+                  "Comma-separated families: box, ellipsoid, cylinder, cone, capsule, prism, shard; or all")
+      ->capture_default_str();
+  app->add_option("--modes", o->modes, "Non-rigid vibration modes per entry")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 200));
+  app->add_option("--threads", o->threads, "Worker threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  app->add_option("--grid", o->grid, "Descriptor grid size N")
+      ->capture_default_str()
+      ->check(CLI::Range(2, core::kMaxGridSize));
+  app->add_option("--sampling", o->sampling, "Descriptor sampling: area or vertices")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"area", "vertices"}));
+  app->add_option("--poisson", o->poisson, "Poisson ratio of the modal analysis")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.499));
+  app->add_option("--batch", o->batch, "Entries per transaction")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  app->add_flag("--resume", o->resume, "Continue an interrupted build of DB with its own parameters");
+  app->add_flag("--quiet", o->quiet, "No progress output");
+  return {app, [o, app] { return runBuild(*o, *app); }};
+}
+
+Command addInfoCommand(CLI::App& parent) {
+  auto o = std::make_shared<InfoOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "info",
+      "Describe a database file: entries per family, failures, build parameters, size on disk, build time.");
+  app->add_option("DB", o->path, "Database file")->required();
+  app->add_flag("--json", o->json, "Print one JSON object instead of text");
+  return {app, [o] { return runInfo(*o); }};
+}
+
+Command addAddCommand(CLI::App& parent) {
+  auto o = std::make_shared<AddOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "add",
+      "Add closed surface meshes to a database as 'user' entries (the scenario-specific database of paper\n"
+      "§7), computed with the database's own parameters; all are added or none.");
+  app->add_option("DB", o->path, "Database file")->required();
+  app->add_option("MESH", o->meshes, "Closed surface mesh files (.obj, .ply, .off, .stl)")->required();
+  return {app, [o] { return runAdd(*o); }};
+}
+
+}  // namespace shapedb::cli

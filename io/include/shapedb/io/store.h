@@ -1,0 +1,98 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <shapedb/core/descriptor.h>
+#include <shapedb/core/index.h>
+#include <shapedb/core/physics.h>
+#include <shapedb/core/result.h>
+#include <shapedb/volume/entry.h>
+#include <shapedb/volume/families.h>
+
+namespace shapedb::io {
+
+/// The version of the file layout below. A file of another version is refused, never guessed at.
+inline constexpr int kSchemaVersion = 1;
+
+/// What a database was built with. Stored in the file; every entry of a file shares them.
+struct BuildParameters {
+  volume::EntryOptions entry;
+  volume::ShapeResolution resolution;
+  std::vector<volume::Family> families;  ///< of the generated catalog
+  std::size_t entries = 4500;            ///< size of the generated catalog
+};
+
+/// The parameters as JSON text (stored in the file's meta table), and back.
+std::string toJson(const BuildParameters& parameters);
+Result<BuildParameters> parseBuildParameters(const std::string& json);
+
+/// One entry's bookkeeping (its physical data live in their own blobs).
+struct EntryRecord {
+  core::EntryId id = 0;
+  std::string name;  ///< "box-00017", or the file name of a user entry
+  volume::Family family = volume::Family::kUser;
+  core::Vec3 params = core::Vec3::Zero();
+  std::string source;  ///< user entries: the file it came from
+  std::size_t nodes = 0, tets = 0;
+  volume::StageTimes times;
+};
+
+/// An entry that failed to build, kept so that a resumed build does not retry it forever and `info` can
+/// say why.
+struct FailureRecord {
+  std::string name;
+  std::string message;
+};
+
+/// The database file (SQLite, WAL mode): schema version and application id in the header, the build
+/// parameters and bookkeeping in `meta`, then `entries`, `descriptors` (one blob per entry and kind),
+/// `physics` (one blob per entry and part: tet mesh, mass properties, modes, collision, sound) and
+/// `failures`. Every blob has a CRC-32 beside it, checked on read.
+///
+/// Thread-safe: one connection in SQLite's serialized mode; writes are one transaction per call.
+class Store {
+ public:
+  /// A new file. Errors: kIo if it exists or cannot be created.
+  static Result<Store> create(const std::filesystem::path& path, const BuildParameters& parameters);
+  /// An existing file. Errors: kIo (missing, unreadable, not SQLite), kParse (another application's
+  /// file, another schema version, unreadable parameters).
+  static Result<Store> open(const std::filesystem::path& path, bool writable = false);
+
+  Store(Store&&) noexcept;
+  Store& operator=(Store&&) noexcept;
+  ~Store();
+
+  const std::filesystem::path& path() const;
+  const BuildParameters& parameters() const;
+
+  /// Writes entries (and failures) in one transaction: all of them or none.
+  /// Errors: kIo (disk full, read-only file, ...), kInvalidArgument (a duplicate id or name).
+  Status write(std::span<const EntryRecord> records, std::span<const volume::EntryData> data,
+               std::span<const FailureRecord> failures = {});
+
+  Result<std::vector<EntryRecord>> entries() const;
+  Result<std::vector<FailureRecord>> failures() const;
+  /// Every entry's descriptor of one kind, checksums verified.
+  Result<std::vector<std::pair<core::EntryId, core::Descriptor>>> descriptors(
+      core::DescriptorKind kind) const;
+  /// One entry's physical data, checksums verified. Errors: kInvalidArgument (no such entry), kParse
+  /// (a corrupted blob: the message names the entry and the part).
+  Result<core::PhysicalData> physics(core::EntryId id) const;
+
+  /// Free-form bookkeeping: "build_seconds", "status", "created".
+  Status setMeta(const std::string& key, const std::string& value);
+  std::optional<std::string> meta(const std::string& key) const;
+
+ private:
+  struct Impl;
+  explicit Store(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> mImpl;
+};
+
+}  // namespace shapedb::io
