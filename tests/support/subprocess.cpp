@@ -1,5 +1,6 @@
 #include "support/subprocess.h"
 
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <sys/wait.h>
@@ -20,6 +21,7 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   argv.push_back(nullptr);
 
   ProcessResult result;
+  std::fflush(nullptr);  // or the child's freopen flushes our pending output a second time
   const pid_t pid = ::fork();
   if (pid == 0) {
     if (!std::freopen(outPath.c_str(), "w", stdout) || !std::freopen(errPath.c_str(), "w", stderr))

@@ -180,11 +180,12 @@ CollisionShape growBox(const Samples& s, int i, int j, int k) {
   return box;
 }
 
-/// The capsule along `axis` through `c` of radius r: each end moves out while the sphere of radius r
-/// there stays inside (the distance at the end point is at least 0.9 r deep).
-CollisionShape growCapsule(const Samples& s, const Vec3& c, double r, int axis) {
+/// The capsule along `axis` through `c` (at depth `depth`) of radius r: each end moves out a voxel at a
+/// time while the solid there is as deep as at c, to half a voxel (so a sphere does not grow into a
+/// capsule, and a capsule's axis is followed to its caps).
+CollisionShape growCapsule(const Samples& s, const Vec3& c, double depth, double r, int axis) {
   const Vec3 direction = Vec3::Unit(axis);
-  const auto fits = [&](double t) { return -s.distanceAt(c + t * direction) >= 0.9 * r; };
+  const auto fits = [&](double t) { return -s.distanceAt(c + t * direction) >= depth - 0.5 * s.voxel; };
   double lo = 0.0, hi = 0.0;
   while (fits(hi + s.voxel) && hi < 1e3 * s.voxel)
     hi += s.voxel;
@@ -223,14 +224,19 @@ Result<core::CollisionCompound> fitCollisionCompound(const core::TriangleMesh& s
     const Vec3 c = samples.center(i, j, k);
     const double depth = -samples.distance[samples.index(i, j, k)];
     std::vector<CollisionShape> candidates;
-    CollisionShape sphere;
-    sphere.type = CollisionShape::Type::kSphere;
-    sphere.center = c;
-    sphere.radius = depth;
-    candidates.push_back(sphere);
     candidates.push_back(growBox(samples, i, j, k));
-    for (int axis = 0; axis < 3; ++axis)
-      candidates.push_back(growCapsule(samples, c, depth, axis));
+    // The depth at a voxel centre understates the inscribed radius by up to a voxel's half-diagonal:
+    // radii from the sampled depth to a voxel more, and the gain picks.
+    for (double extra : {0.0, 0.5, 1.0}) {
+      const double r = depth + extra * samples.voxel;
+      CollisionShape sphere;
+      sphere.type = CollisionShape::Type::kSphere;
+      sphere.center = c;
+      sphere.radius = r;
+      candidates.push_back(sphere);
+      for (int axis = 0; axis < 3; ++axis)
+        candidates.push_back(growCapsule(samples, c, depth, r, axis));
+    }
 
     double bestGain = 0.0;
     const CollisionShape* best = nullptr;

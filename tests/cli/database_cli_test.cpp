@@ -1,0 +1,160 @@
+// The database subcommands as a user runs them: the real executable, a real file, a real SIGKILL.
+
+#include <chrono>
+#include <signal.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sqlite3.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/mesh_io.h>
+#include <shapedb/io/store.h>
+
+#include "support/subprocess.h"
+#include "support/test_support.h"
+
+namespace shapedb::cli {
+namespace {
+
+/// Every row of the tables that hold the entries, as text (blobs as hex), ordered: what two databases
+/// must share to be "the same database". Build times are left out.
+std::string dumpEntries(const std::filesystem::path& path) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  std::string out;
+  for (const char* sql :
+       {"SELECT id, name, family, params, source, nodes, tets FROM entries ORDER BY id",
+        "SELECT entry_id, kind, hex(data), checksum FROM descriptors ORDER BY entry_id, kind",
+        "SELECT entry_id, part, hex(data), checksum FROM physics ORDER BY entry_id, part",
+        "SELECT name, message FROM failures ORDER BY name"}) {
+    sqlite3_stmt* stmt = nullptr;
+    EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &stmt, nullptr), SQLITE_OK);
+    while (sqlite3_step(stmt) == SQLITE_ROW) {
+      for (int c = 0; c < sqlite3_column_count(stmt); ++c) {
+        const auto* text = sqlite3_column_text(stmt, c);
+        out += text ? reinterpret_cast<const char*>(text) : "NULL";
+        out += '|';
+      }
+      out += '\n';
+    }
+    sqlite3_finalize(stmt);
+  }
+  sqlite3_close(db);
+  return out;
+}
+
+std::size_t committedEntries(const std::filesystem::path& path) {
+  auto store = io::Store::open(path);
+  if (!store) return 0;
+  auto entries = store->entries();
+  return entries ? entries->size() : 0;
+}
+
+TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
+  test::ScratchDir dir("build-kill");
+  const auto killed = dir / "killed.db", clean = dir / "clean.db";
+  const std::vector<std::string> args = {"--entries", "24", "--families", "box,cone,shard",
+                                         "--modes",   "4",  "--threads",  "1",
+                                         "--batch",   "2",  "--quiet"};
+
+  // Start a build and kill it for real once a few batches are committed (and the next is in flight).
+  std::vector<std::string> argv = {SHAPEDB_CLI, "build", killed.string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv;
+  for (std::string& a : argv)
+    cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execv(SHAPEDB_CLI, cargv.data());
+    ::_exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  std::size_t before = 0;
+  while ((before = committedEntries(killed)) < 6 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
+      << "the build finished before it was killed";
+  const std::size_t atKill = committedEntries(killed);
+  std::printf("killed with %zu of 24 entries committed\n", atKill);
+  ASSERT_GE(atKill, 6u);
+  ASSERT_LT(atKill, 24u);
+
+  // Resume with no parameters: the file's own are used.
+  test::ProcessResult resumed =
+      test::runProcess(SHAPEDB_CLI, {"build", killed.string(), "--resume", "--quiet"});
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find(std::to_string(atKill) + " already there"), std::string::npos) << resumed.out;
+
+  std::vector<std::string> cleanArgs = {"build", clean.string()};
+  cleanArgs.insert(cleanArgs.end(), args.begin(), args.end());
+  test::ProcessResult fresh = test::runProcess(SHAPEDB_CLI, cleanArgs);
+  ASSERT_EQ(fresh.exitCode, 0) << fresh.err;
+
+  const std::string a = dumpEntries(killed), b = dumpEntries(clean);
+  EXPECT_EQ(committedEntries(killed), 24u);
+  EXPECT_TRUE(a == b) << "the resumed database differs from the clean one";
+
+  // A resume that asks for other parameters is refused, and says why.
+  test::ProcessResult conflict =
+      test::runProcess(SHAPEDB_CLI, {"build", killed.string(), "--resume", "--modes", "8", "--quiet"});
+  EXPECT_EQ(conflict.exitCode, 2);
+  EXPECT_NE(conflict.err.find("was built with another modes"), std::string::npos) << conflict.err;
+}
+
+TEST(BuildCli, InfoAndAddEndToEnd) {
+  test::ScratchDir dir("build-info");
+  const auto db = dir / "small.db";
+  test::ProcessResult built = test::runProcess(
+      SHAPEDB_CLI,
+      {"build", db.string(), "--entries", "4", "--families", "box,prism", "--modes", "3", "--quiet"});
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  EXPECT_NE(built.out.find("4 entries built"), std::string::npos) << built.out;
+
+  const auto mesh = dir / "wedge.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeTriangularPrism(1.0, 0.3, 2.0), mesh).ok());
+  test::ProcessResult added = test::runProcess(SHAPEDB_CLI, {"add", db.string(), mesh.string()});
+  ASSERT_EQ(added.exitCode, 0) << added.err;
+  EXPECT_NE(added.out.find("added as entry 4"), std::string::npos) << added.out;
+
+  test::ProcessResult info = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
+  ASSERT_EQ(info.exitCode, 0) << info.err;
+  const nlohmann::json j = nlohmann::json::parse(info.out);
+  EXPECT_EQ(j["entries"], 5);
+  EXPECT_EQ(j["families"]["box"], 2);
+  EXPECT_EQ(j["families"]["prism"], 2);
+  EXPECT_EQ(j["families"]["user"], 1);
+  EXPECT_EQ(j["status"], "complete");
+  EXPECT_EQ(j["parameters"]["modes"]["count"], 3);
+  EXPECT_GT(j["size_bytes"].get<double>(), 0.0);
+
+  test::ProcessResult text = test::runProcess(SHAPEDB_CLI, {"info", db.string()});
+  EXPECT_EQ(text.exitCode, 0);
+  EXPECT_NE(text.out.find("entries: 5"), std::string::npos) << text.out;
+
+  // Bad inputs: a mesh that does not exist, a file that is not a database, an unknown family.
+  test::ProcessResult missing =
+      test::runProcess(SHAPEDB_CLI, {"add", db.string(), (dir / "none.obj").string()});
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("none.obj"), std::string::npos) << missing.err;
+  test::ProcessResult notDb = test::runProcess(SHAPEDB_CLI, {"info", mesh.string()});
+  EXPECT_EQ(notDb.exitCode, 1);
+  EXPECT_NE(notDb.err.find("not a database"), std::string::npos) << notDb.err;
+  test::ProcessResult family =
+      test::runProcess(SHAPEDB_CLI, {"build", (dir / "x.db").string(), "--families", "torus"});
+  EXPECT_EQ(family.exitCode, 2);
+  EXPECT_NE(family.err.find("unknown family 'torus'"), std::string::npos) << family.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.db"));
+}
+
+}  // namespace
+}  // namespace shapedb::cli

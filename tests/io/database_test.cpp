@@ -1,0 +1,233 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/database.h>
+#include <shapedb/io/store.h>
+#include <shapedb/volume/families.h>
+#include <shapedb/volume/modal.h>
+
+#include "support/test_support.h"
+
+namespace shapedb::io {
+namespace {
+
+using core::DescriptorKind;
+
+BuildOptions smallBuild(std::size_t entries, std::vector<volume::Family> families, int modes = 6) {
+  BuildOptions options;
+  options.parameters.entries = entries;
+  options.parameters.families = std::move(families);
+  options.parameters.entry.modal.modes = modes;
+  options.threads = 2;
+  options.batchSize = 4;
+  return options;
+}
+
+/// One database for the suite: 3 entries of each generated family.
+class SmallDatabase : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    sDir = new test::ScratchDir("database");
+    sPath = sDir->path() / "small.db";
+    const auto families = volume::generatedFamilies();
+    auto report = buildDatabase(sPath, smallBuild(3 * families.size(), {families.begin(), families.end()}));
+    ASSERT_TRUE(report.ok()) << report.error().message;
+    ASSERT_EQ(report->built, 3 * families.size());
+    ASSERT_EQ(report->failed, 0u);
+  }
+  static void TearDownTestSuite() {
+    delete sDir;
+    sDir = nullptr;
+  }
+  static test::ScratchDir* sDir;
+  static std::filesystem::path sPath;
+};
+test::ScratchDir* SmallDatabase::sDir = nullptr;
+std::filesystem::path SmallDatabase::sPath;
+
+TEST_F(SmallDatabase, EveryEntryQueriedWithItsOwnSurfaceUnderARigidTransformIsTopOne) {
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  ASSERT_EQ(db->entries().size(), 21u);
+  std::mt19937_64 rng(2024);
+  for (const EntryRecord& e : db->entries()) {
+    const volume::ShapeSpec spec = volume::familySpec(
+        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    ASSERT_EQ(spec.name(), e.name);
+    auto surface = volume::makeFamilyShape(spec, db->parameters().resolution);
+    ASSERT_TRUE(surface.ok());
+    for (DescriptorKind kind :
+         {DescriptorKind::kMoment, DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
+      // A rigid transform: rotation and translation, scale 1 (the descriptors do not see scale anyway).
+      const core::TriangleMesh moved =
+          core::transformed(*surface, test::randomSimilarity(rng, 5.0, 1.0, 1.0));
+      auto matches = db->match(moved, kind, {.k = 3});
+      ASSERT_TRUE(matches.ok()) << matches.error().message;
+      EXPECT_LT(matches->front().distance, 1e-6) << e.name << " " << core::toString(kind);
+      if (kind == DescriptorKind::kVoxel && matches->front().entry != e.id) {
+        // Binary occupancy cannot tell a short capsule from the cylinder of the same proportions on a 10³
+        // grid: they fill the same cells. Then the entry must tie for first, at distance 0.
+        const auto self = std::find_if(matches->begin(), matches->end(),
+                                       [&](const core::Match& m) { return m.entry == e.id; });
+        ASSERT_NE(self, matches->end()) << e.name;
+        EXPECT_EQ(self->distance, matches->front().distance) << e.name;
+        std::printf("voxel tie: %s and entry %u at distance %g\n", e.name.c_str(), matches->front().entry,
+                    matches->front().distance);
+        continue;
+      }
+      EXPECT_EQ(matches->front().entry, e.id)
+          << e.name << " by " << core::toString(kind) << ": got entry " << matches->front().entry << " at "
+          << matches->front().distance;
+    }
+  }
+}
+
+TEST_F(SmallDatabase, PhysicsReadBackMatchesAFreshComputation) {
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok());
+  const EntryRecord& e = db->entries()[4];
+  auto physics = db->physics(e.id);
+  ASSERT_TRUE(physics.ok()) << physics.error().message;
+  auto surface = volume::makeFamilyShape(volume::familySpec(e.family, 1), db->parameters().resolution);
+  ASSERT_TRUE(surface.ok());
+  auto fresh = volume::computeEntry(*surface, db->parameters().entry);
+  ASSERT_TRUE(fresh.ok());
+  const core::PhysicalData& p = **physics;
+  ASSERT_EQ(p.tetMesh.tets, fresh->physics.tetMesh.tets);
+  ASSERT_EQ(p.tetMesh.nodes, fresh->physics.tetMesh.nodes);
+  EXPECT_NEAR(p.massProperties.volume, 1.0, 1e-9);
+  ASSERT_EQ(p.modes.modeCount(), 6u);
+  EXPECT_EQ(p.modes.eigenvalues, fresh->physics.modes.eigenvalues);
+  // Shapes are stored as 16-bit integers per mode: within 2⁻¹⁵ of the largest component.
+  for (Eigen::Index i = 0; i < 6; ++i) {
+    const double largest = fresh->physics.modes.shapes.col(i).cwiseAbs().maxCoeff();
+    EXPECT_LT((p.modes.shapes.col(i) - fresh->physics.modes.shapes.col(i)).cwiseAbs().maxCoeff(),
+              largest / 32767.0);
+  }
+  // Still M-orthonormal to ~1e-4 after that rounding.
+  const volume::FemMatrices fem =
+      volume::assembleFem(p.tetMesh, {.youngsModulus = 1, .poissonRatio = 0.3, .density = 1});
+  const Eigen::MatrixXd gram = p.modes.shapes.transpose() * fem.mass * p.modes.shapes;
+  EXPECT_LT((gram - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_EQ(p.collision.shapes.size(), fresh->physics.collision.shapes.size());
+  EXPECT_EQ(p.sound.frequenciesHz, fresh->physics.sound.frequenciesHz);
+  // The second read comes from the cache.
+  ASSERT_TRUE(db->physics(e.id).ok());
+  EXPECT_EQ(db->cacheStats()[0], 1u);
+}
+
+TEST_F(SmallDatabase, OtherDescriptorParametersAreAClearError) {
+  core::DescriptorOptions other;
+  other.gridSize = 12;
+  auto db = Database::open(sPath, {.cacheEntries = 4, .expectDescriptor = other});
+  ASSERT_FALSE(db.ok());
+  EXPECT_NE(db.error().message.find("grid 10"), std::string::npos) << db.error().message;
+}
+
+TEST_F(SmallDatabase, CorruptedTruncatedAndForeignFilesAreClearErrors) {
+  // A copy with one physics blob's bytes changed behind its checksum.
+  const auto corrupted = sDir->path() / "corrupted.db";
+  std::filesystem::copy_file(sPath, corrupted);
+  {
+    auto store = Store::open(corrupted, true);
+    ASSERT_TRUE(store.ok());
+  }
+  {
+    // Flip the blob through SQLite itself, so the file stays a valid SQLite file.
+    const std::string sql =
+        "sqlite3 " + corrupted.string() +
+        " \"UPDATE physics SET data = zeroblob(length(data)) WHERE entry_id = 2 AND part = 2\"";
+    ASSERT_EQ(std::system(sql.c_str()), 0) << "needs the sqlite3 shell";
+  }
+  auto db = Database::open(corrupted);
+  ASSERT_TRUE(db.ok()) << db.error().message;  // descriptors are intact
+  auto physics = db->physics(2);
+  ASSERT_FALSE(physics.ok());
+  EXPECT_NE(physics.error().message.find("entry 2: modes: checksum mismatch"), std::string::npos)
+      << physics.error().message;
+
+  // Truncated to half its size: SQLite notices, we say which file.
+  const auto truncated = sDir->path() / "truncated.db";
+  std::filesystem::copy_file(sPath, truncated);
+  std::filesystem::resize_file(truncated, std::filesystem::file_size(truncated) / 2);
+  auto t = Database::open(truncated);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.error().message.find("truncated.db"), std::string::npos) << t.error().message;
+
+  // Not a database at all, and another application's SQLite file.
+  const auto text = sDir->path() / "notes.db";
+  test::writeFile(text, "these are not the entries you are looking for\n");
+  auto n = Database::open(text);
+  ASSERT_FALSE(n.ok());
+  EXPECT_NE(n.error().message.find("not a database"), std::string::npos) << n.error().message;
+  const auto foreign = sDir->path() / "foreign.db";
+  ASSERT_EQ(std::system(("sqlite3 " + foreign.string() + " \"CREATE TABLE t(x)\"").c_str()), 0);
+  auto f = Database::open(foreign);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().message.find("not a shapedb database"), std::string::npos) << f.error().message;
+
+  // Another schema version.
+  const auto future = sDir->path() / "future.db";
+  std::filesystem::copy_file(sPath, future);
+  ASSERT_EQ(std::system(("sqlite3 " + future.string() + " \"PRAGMA user_version = 99\"").c_str()), 0);
+  auto v = Database::open(future);
+  ASSERT_FALSE(v.ok());
+  EXPECT_NE(v.error().message.find("schema version 99"), std::string::npos) << v.error().message;
+}
+
+TEST(Database, BuildRefusesToOverwriteAndResumeNeedsAFile) {
+  test::ScratchDir dir("database-guards");
+  const auto path = dir / "a.db";
+  BuildOptions options = smallBuild(2, {volume::Family::kBox}, 2);
+  ASSERT_TRUE(buildDatabase(path, options).ok());
+  auto again = buildDatabase(path, options);
+  ASSERT_FALSE(again.ok());
+  EXPECT_NE(again.error().message.find("already exists"), std::string::npos);
+  options.resume = true;
+  auto resumed = buildDatabase(path, options);  // complete: nothing to do
+  ASSERT_TRUE(resumed.ok());
+  EXPECT_EQ(resumed->built, 0u);
+  EXPECT_EQ(resumed->skipped, 2u);
+  auto missing = buildDatabase(dir / "b.db", options);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("no database to resume"), std::string::npos);
+}
+
+TEST(Database, AddedMeshesAreFoundAndAnOpenOneIsRefusedWithNothingWritten) {
+  test::ScratchDir dir("database-add");
+  const auto path = dir / "a.db";
+  ASSERT_TRUE(buildDatabase(path, smallBuild(2, {volume::Family::kBox}, 2)).ok());
+  const core::TriangleMesh wedge = core::makeTriangularPrism(1.0, 0.4, 3.0);
+  core::TriangleMesh open = core::makeBox(core::Vec3(1, 2, 3));
+  open.triangles.pop_back();
+  const std::vector<NamedMesh> bad = {{"wedge.obj", "wedge.obj", wedge}, {"open.obj", "open.obj", open}};
+  auto refused = addToDatabase(path, bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("open.obj"), std::string::npos) << refused.error().message;
+  EXPECT_EQ(Database::open(path)->entries().size(), 2u);  // all or none
+
+  auto ids = addToDatabase(path, std::span(bad).first(1));
+  ASSERT_TRUE(ids.ok()) << ids.error().message;
+  ASSERT_EQ(ids->size(), 1u);
+  EXPECT_EQ(ids->front(), 2u);
+  auto db = Database::open(path);
+  ASSERT_TRUE(db.ok());
+  EXPECT_EQ(db->entry(2)->family, volume::Family::kUser);
+  std::mt19937_64 rng(5);
+  auto matches =
+      db->match(core::transformed(wedge, test::randomSimilarity(rng)), DescriptorKind::kCentroidVoxel);
+  ASSERT_TRUE(matches.ok());
+  EXPECT_EQ(matches->front().entry, 2u);
+  auto duplicate = addToDatabase(path, std::span(bad).first(1));
+  ASSERT_FALSE(duplicate.ok());
+  EXPECT_NE(duplicate.error().message.find("already in the database"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace shapedb::io
