@@ -41,7 +41,9 @@ Samples sampleSolid(const core::TriangleMesh& surface, int resolution) {
   initializeOpenVdb();
   const core::Bounds bounds = core::computeBounds(surface);
   Samples s;
-  s.voxel = bounds.extent().maxCoeff() / resolution;
+  // `resolution` voxels along the largest extent, and at least 6 across the smallest: a thin plate or
+  // needle must still have voxels inside it (and OpenVDB's sign flood needs some thickness).
+  s.voxel = std::min(bounds.extent().maxCoeff() / resolution, bounds.extent().minCoeff() / 6.0);
   const int pad = 2;  // room for compound overshoot around the solid
   for (int a = 0; a < 3; ++a)
     s.n[a] = static_cast<int>(std::ceil(bounds.extent()[a] / s.voxel)) + 2 * pad;
@@ -59,7 +61,7 @@ Samples sampleSolid(const core::TriangleMesh& surface, int resolution) {
   for (const auto& t : surface.triangles)
     triangles.emplace_back(t[0], t[1], t[2]);
   // The interior band covers the whole solid: distances everywhere inside, for the inscribed spheres.
-  const float interior = static_cast<float>(resolution);
+  const float interior = static_cast<float>(bounds.extent().maxCoeff() / s.voxel);
   const auto grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(
       *transform, points, triangles, std::vector<openvdb::Vec4I>{}, 3.0f, interior);
   const auto accessor = grid->getConstAccessor();

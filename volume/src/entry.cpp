@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -36,9 +37,27 @@ Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOpt
   const core::TriangleMesh canonical = core::transformed(surface, normalization->canonicalFromMesh);
   entry.times.normalize = clock.lap();
 
-  auto tets = tetrahedralize(canonical, options.tetgen);
+  // TetGen gets the surface as it came, then its nodes go to the canonical frame (a similarity with
+  // positive determinant: tets stay positive). The canonical frame's rotated coordinates put the corners
+  // of a box's faces off their plane by round-off, and TetGen 1.5 aborts on some such boxes (box-00221
+  // of the default catalog did).
+  // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
+  // cone's tip did, 4 times in the 4,500-entry catalog): retry with a looser bound, then with none.
+  auto tets = tetrahedralize(surface, options.tetgen);
+  for (double relaxed : {2.5, 0.0}) {
+    if (tets || tets.error().code == ErrorCode::kInvalidArgument ||
+        options.tetgen.maxRadiusEdgeRatio == 0.0 ||
+        (relaxed > 0.0 && options.tetgen.maxRadiusEdgeRatio >= relaxed))
+      continue;
+    TetrahedralizeOptions looser = options.tetgen;
+    looser.maxRadiusEdgeRatio = relaxed;
+    looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
+    tets = tetrahedralize(surface, looser);
+  }
   if (!tets) return withContext(tets.error(), "tetrahedralize");
   entry.physics.tetMesh = std::move(tets).value();
+  for (core::Vec3& p : entry.physics.tetMesh.nodes)
+    p = core::transformPoint(normalization->canonicalFromMesh, p);
   entry.physics.massProperties = core::computeTetMassProperties(entry.physics.tetMesh);
   // The tets must fill the surface: unit volume, centre at the origin, in the canonical frame.
   const core::MassProperties& m = entry.physics.massProperties;

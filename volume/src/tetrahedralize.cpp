@@ -267,17 +267,22 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume) 
   // p: the input is a piecewise linear complex; q: quality bound; a: volume bound; Q: quiet;
   // z: number from zero.
   char buffer[96];
-  if (options.maxVolumeFraction > 0.0)
-    std::snprintf(buffer, sizeof buffer, "pq%.3ga%.6gQz", options.maxRadiusEdgeRatio,
-                  options.maxVolumeFraction * volume);
-  else
-    std::snprintf(buffer, sizeof buffer, "pq%.3gQz", options.maxRadiusEdgeRatio);
-  return buffer;
+  std::string switches = "p";
+  if (options.maxRadiusEdgeRatio > 0.0) {
+    std::snprintf(buffer, sizeof buffer, "q%.3g", options.maxRadiusEdgeRatio);
+    switches += buffer;
+  }
+  if (options.maxVolumeFraction > 0.0) {
+    std::snprintf(buffer, sizeof buffer, "a%.6g", options.maxVolumeFraction * volume);
+    switches += buffer;
+  }
+  return switches + "Qz";
 }
 
 Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options) {
-  if (!(options.maxRadiusEdgeRatio >= 1.1 && std::isfinite(options.maxRadiusEdgeRatio)))
-    return Error{ErrorCode::kInvalidArgument, "TetGen radius-edge ratio must be at least 1.1"};
+  if (!((options.maxRadiusEdgeRatio >= 1.1 || options.maxRadiusEdgeRatio == 0.0) &&
+        std::isfinite(options.maxRadiusEdgeRatio)))
+    return Error{ErrorCode::kInvalidArgument, "TetGen radius-edge ratio must be at least 1.1 (or 0: none)"};
   if (!(options.maxVolumeFraction >= 0.0 && options.maxVolumeFraction <= 1.0))
     return Error{ErrorCode::kInvalidArgument, "TetGen volume fraction must be in [0, 1]"};
   if (Status valid = core::validateMesh(surface); !valid) return valid.error();

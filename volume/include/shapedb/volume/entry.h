@@ -49,7 +49,8 @@ struct EntryData {
 /// The offline pipeline for one shape (paper §3.1): exact mass properties → normalize → the surface in
 /// its canonical frame → TetGen (guarded unless options.tetgen says otherwise) → mass properties of the
 /// tets, checked against the surface's (volume to 1e-9) → the three descriptors → FEM and modes → collision
-/// compound → sound data. Thread-safe (no shared state); the caller parallelizes over entries.
+/// compound → sound data. TetGen meshes the surface as given; its nodes are then mapped to the canonical
+/// frame. Thread-safe (no shared state); the caller parallelizes over entries.
 /// Errors: whichever stage failed, its message prefixed with the stage ("tetrahedralize: ...").
 Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOptions& options);
 

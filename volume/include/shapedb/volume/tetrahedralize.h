@@ -10,7 +10,8 @@ namespace shapedb::volume {
 
 /// TetGen's quality switches (its manual, §4.2) and how to run it.
 struct TetrahedralizeOptions {
-  /// Maximum radius-edge ratio of a tet ('q'); TetGen refines until every tet meets it. ≥ 1.1.
+  /// Maximum radius-edge ratio of a tet ('q'); TetGen refines until every tet meets it. ≥ 1.1, or 0 for
+  /// no quality bound (TetGen's refinement can fail to end near sharp input angles, a slender cone's tip).
   double maxRadiusEdgeRatio = 1.5;
   /// Maximum tet volume ('a') as a fraction of the solid's volume: about 1/maxVolumeFraction tets at
   /// least. 0: no volume bound.
@@ -20,7 +21,7 @@ struct TetrahedralizeOptions {
   /// the caller made itself and for measuring the cost of the guard.
   bool guarded = true;
   /// Guarded only: the child is killed after this long and the call fails.
-  double timeoutSeconds = 120.0;
+  double timeoutSeconds = 30.0;
 };
 
 /// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like.
