@@ -102,7 +102,18 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
 
   const std::string a = dumpEntries(killed), b = dumpEntries(clean);
   EXPECT_EQ(committedEntries(killed), 24u);
-  EXPECT_TRUE(a == b) << "the resumed database differs from the clean one";
+  if (a != b) {
+    // Say where: the first line that differs (blobs are hex, so cut it short).
+    std::size_t line = 0, at = 0;
+    while (at < std::min(a.size(), b.size()) && a[at] == b[at])
+      line += a[at++] == '\n' ? 1 : 0;
+    const auto lineAt = [](const std::string& s, std::size_t from) {
+      const std::size_t begin = s.rfind('\n', from) == std::string::npos ? 0 : s.rfind('\n', from) + 1;
+      return s.substr(begin, std::min<std::size_t>(200, s.find('\n', begin) - begin));
+    };
+    ADD_FAILURE() << "the resumed database differs from the clean one at row " << line
+                  << ":\n  resumed: " << lineAt(a, at) << "\n  clean:   " << lineAt(b, at);
+  }
 
   // A resume that asks for other parameters is refused, and says why.
   test::ProcessResult conflict =
