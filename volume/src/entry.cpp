@@ -44,6 +44,11 @@ Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOpt
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
   // cone's tip did, 4 times in the 4,500-entry catalog): retry with a looser bound, then with none.
   auto tets = tetrahedralize(surface, options.tetgen);
+  if (!tets && tets.error().code == ErrorCode::kIo) {
+    // The worker process died or hung: first the same request once more in a fresh worker, so that a
+    // broken worker (not TetGen's answer) never changes what the entry holds.
+    tets = tetrahedralize(surface, options.tetgen);
+  }
   for (double relaxed : {2.5, 0.0}) {
     if (tets || tets.error().code == ErrorCode::kInvalidArgument ||
         options.tetgen.maxRadiusEdgeRatio == 0.0 ||
