@@ -1,4 +1,3 @@
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -41,24 +40,7 @@ Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOpt
   // positive determinant: tets stay positive). The canonical frame's rotated coordinates put the corners
   // of a box's faces off their plane by round-off, and TetGen 1.5 aborts on some such boxes (box-00221
   // of the default catalog did).
-  // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
-  // cone's tip did, 4 times in the 4,500-entry catalog): retry with a looser bound, then with none.
   auto tets = tetrahedralize(surface, options.tetgen);
-  if (!tets && tets.error().code == ErrorCode::kIo) {
-    // The worker process died or hung: first the same request once more in a fresh worker, so that a
-    // broken worker (not TetGen's answer) never changes what the entry holds.
-    tets = tetrahedralize(surface, options.tetgen);
-  }
-  for (double relaxed : {2.5, 0.0}) {
-    if (tets || tets.error().code == ErrorCode::kInvalidArgument ||
-        options.tetgen.maxRadiusEdgeRatio == 0.0 ||
-        (relaxed > 0.0 && options.tetgen.maxRadiusEdgeRatio >= relaxed))
-      continue;
-    TetrahedralizeOptions looser = options.tetgen;
-    looser.maxRadiusEdgeRatio = relaxed;
-    looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
-    tets = tetrahedralize(surface, looser);
-  }
   if (!tets) return withContext(tets.error(), "tetrahedralize");
   entry.physics.tetMesh = std::move(tets).value();
   for (core::Vec3& p : entry.physics.tetMesh.nodes)

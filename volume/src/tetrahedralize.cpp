@@ -279,17 +279,12 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume) 
   return switches + "Qz";
 }
 
-Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options) {
-  if (!((options.maxRadiusEdgeRatio >= 1.1 || options.maxRadiusEdgeRatio == 0.0) &&
-        std::isfinite(options.maxRadiusEdgeRatio)))
-    return Error{ErrorCode::kInvalidArgument, "TetGen radius-edge ratio must be at least 1.1 (or 0: none)"};
-  if (!(options.maxVolumeFraction >= 0.0 && options.maxVolumeFraction <= 1.0))
-    return Error{ErrorCode::kInvalidArgument, "TetGen volume fraction must be in [0, 1]"};
-  if (Status valid = core::validateMesh(surface); !valid) return valid.error();
-  auto mass = core::computeMassProperties(surface);
-  if (!mass) return mass.error();
+namespace {
 
-  const std::string switches = tetgenSwitches(options, mass->volume);
+/// One TetGen run with these switches, its output checked and turned positive.
+Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const TetrahedralizeOptions& options,
+                                   double volume) {
+  const std::string switches = tetgenSwitches(options, volume);
   RawResult raw;
   if (options.guarded) {
     auto guarded = runTetGenGuarded(surface, switches, options.timeoutSeconds);
@@ -318,6 +313,37 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   if (Status valid = core::validateTetMesh(mesh); !valid)
     return Error{ErrorCode::kParse, "TetGen returned an invalid mesh: " + valid.error().message};
   return mesh;
+}
+
+}  // namespace
+
+Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options) {
+  if (!((options.maxRadiusEdgeRatio >= 1.1 || options.maxRadiusEdgeRatio == 0.0) &&
+        std::isfinite(options.maxRadiusEdgeRatio)))
+    return Error{ErrorCode::kInvalidArgument, "TetGen radius-edge ratio must be at least 1.1 (or 0: none)"};
+  if (!(options.maxVolumeFraction >= 0.0 && options.maxVolumeFraction <= 1.0))
+    return Error{ErrorCode::kInvalidArgument, "TetGen volume fraction must be in [0, 1]"};
+  if (Status valid = core::validateMesh(surface); !valid) return valid.error();
+  auto mass = core::computeMassProperties(surface);
+  if (!mass) return mass.error();
+
+  Result<TetMesh> tets = tetrahedralizeOnce(surface, options, mass->volume);
+  if (!options.relaxOnFailure) return tets;
+  // The guarded worker died or hung: the same request once more in a fresh worker first, so that a broken
+  // worker (rather than TetGen's answer) never changes the mesh.
+  if (!tets && tets.error().code == ErrorCode::kIo && options.guarded)
+    tets = tetrahedralizeOnce(surface, options, mass->volume);
+  // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
+  // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
+  for (double relaxed : {2.5, 0.0}) {
+    if (tets || options.maxRadiusEdgeRatio == 0.0 || (relaxed > 0.0 && options.maxRadiusEdgeRatio >= relaxed))
+      continue;
+    TetrahedralizeOptions looser = options;
+    looser.maxRadiusEdgeRatio = relaxed;
+    looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
+    tets = tetrahedralizeOnce(surface, looser, mass->volume);
+  }
+  return tets;
 }
 
 }  // namespace shapedb::volume

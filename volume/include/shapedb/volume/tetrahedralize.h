@@ -22,6 +22,10 @@ struct TetrahedralizeOptions {
   bool guarded = true;
   /// Guarded only: the child is killed after this long and the call fails.
   double timeoutSeconds = 30.0;
+  /// When TetGen fails: a guarded run is repeated once in a fresh worker, then the quality bound is
+  /// loosened to 2.5 and then dropped (10 s timeout each). TetGen's refinement can abort, hang or return
+  /// a flat tet near sharp input angles.
+  bool relaxOnFailure = true;
 };
 
 /// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like.
