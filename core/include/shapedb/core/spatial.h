@@ -1,0 +1,101 @@
+#pragma once
+// Spatial queries on the meshes a query meets: where a point lies in a tet mesh, and the closest point
+// of a triangle surface. Both are built once per mesh and then answer queries from many threads.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <shapedb/core/physics.h>
+#include <shapedb/core/triangle_mesh.h>
+#include <shapedb/core/types.h>
+
+namespace shapedb::core {
+
+/// Closest point of a triangle to a point (Ericson, Real-Time Collision Detection §5.1.5), with the
+/// barycentric coordinates of that point on the triangle (they sum to 1 and are ≥ 0).
+struct TrianglePoint {
+  Vec3 point = Vec3::Zero();
+  std::array<double, 3> barycentric{};
+  double squaredDistance = 0.0;
+};
+TrianglePoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Closest-point queries on a triangle surface: an AABB tree (median split, ≤ 4 triangles a leaf),
+/// searched nearest box first. Immutable once built: concurrent queries are safe. Keeps a copy of the
+/// surface's vertices and triangles.
+class ClosestPointTree {
+ public:
+  ClosestPointTree() = default;
+  explicit ClosestPointTree(const TriangleMesh& surface);
+
+  struct Hit {
+    std::uint32_t triangle = 0;
+    TrianglePoint closest;
+  };
+  /// The closest point of the surface to `p`. Precondition: the surface has a triangle.
+  Hit closest(const Vec3& p) const;
+  const TriangleMesh& surface() const { return mSurface; }
+  bool empty() const { return mSurface.triangles.empty(); }
+
+ private:
+  struct Node {
+    Vec3 min, max;
+    std::uint32_t begin = 0, end = 0;  ///< leaf: range of mOrder
+    std::int32_t left = -1, right = -1;
+  };
+  std::int32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Vec3>& centroids);
+  TriangleMesh mSurface;
+  std::vector<std::uint32_t> mOrder;  ///< triangle indices, leaves contiguous
+  std::vector<Node> mNodes;
+};
+
+/// Where a point lies in a tet mesh: the tet that contains it and its barycentric weights, or, outside
+/// the mesh, the tet owning the closest boundary face and the weights of that closest point. Either way
+/// the four weights are ≥ 0 (to round-off) and sum to 1.
+struct TetLocation {
+  std::uint32_t tet = 0;
+  std::array<double, 4> weights{};
+  double distance = 0.0;  ///< 0 inside; else the distance to the mesh
+  bool inside() const { return distance == 0.0; }
+};
+
+/// Point location in a tet mesh: a uniform grid of cells (about two per tet) listing the tets whose
+/// bounding boxes overlap them, for points inside; a ClosestPointTree on the boundary faces, for points
+/// outside. Among the tets containing a point (several, on a shared face or edge) the one where the point
+/// is deepest wins, so the answer is the same as locateBruteForce's. Immutable once built.
+class TetLocator {
+ public:
+  TetLocator() = default;
+  /// Precondition: validateTetMesh(mesh) passed. Keeps a copy of what it needs.
+  explicit TetLocator(const TetMesh& mesh);
+
+  TetLocation locate(const Vec3& p) const;
+  std::size_t tetCount() const { return mTets.size(); }
+  /// The boundary faces, each wound outward, over the mesh's own node indices.
+  const TriangleMesh& boundary() const { return mBoundary.surface(); }
+  const ClosestPointTree& boundaryTree() const { return mBoundary; }
+  /// The tet each boundary face belongs to.
+  const std::vector<std::uint32_t>& boundaryOwner() const { return mOwner; }
+
+ private:
+  friend TetLocation locateBruteForce(const TetLocator& locator, const Vec3& p);
+  /// Barycentric weights of p in tet t: {1 − Σ, λ₁, λ₂, λ₃} with λ = inverse(edges) (p − a).
+  std::array<double, 4> weightsIn(std::uint32_t t, const Vec3& p) const;
+  TetLocation outside(const Vec3& p) const;
+
+  std::vector<Vec3> mNodes;
+  std::vector<TetMesh::Tet> mTets;
+  std::vector<Mat3> mInverse;  ///< per tet: inverse of [b − a, c − a, d − a]
+  Vec3 mOrigin = Vec3::Zero();
+  Vec3 mInvCell = Vec3::Zero();
+  std::array<int, 3> mDims{};
+  std::vector<std::uint32_t> mCellBegin;  ///< CSR: cells + 1 offsets into mCellTets
+  std::vector<std::uint32_t> mCellTets;
+  ClosestPointTree mBoundary;
+  std::vector<std::uint32_t> mOwner;
+};
+
+/// The oracle of TetLocator::locate: every tet tried, every boundary face measured.
+TetLocation locateBruteForce(const TetLocator& locator, const Vec3& p);
+
+}  // namespace shapedb::core

@@ -1,0 +1,297 @@
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+
+#include <shapedb/core/spatial.h>
+
+namespace shapedb::core {
+
+TrianglePoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Voronoi regions of the vertices, then of the edges, then the face.
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const auto result = [&p](const Vec3& q, double u, double v, double w) {
+    return TrianglePoint{q, {u, v, w}, (p - q).squaredNorm()};
+  };
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return result(a, 1, 0, 0);
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return result(b, 0, 1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    return result(a + v * ab, 1 - v, v, 0);
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return result(c, 0, 0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double w = d2 / (d2 - d6);
+    return result(a + w * ac, 1 - w, 0, w);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return result(b + w * (c - b), 0, 1 - w, w);
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return result(a + v * ab + w * ac, 1 - v - w, v, w);
+}
+
+namespace {
+
+constexpr std::uint32_t kLeafSize = 4;
+
+double boxSquaredDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).squaredNorm();
+}
+
+}  // namespace
+
+ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) : mSurface(surface) {
+  const auto n = static_cast<std::uint32_t>(mSurface.triangles.size());
+  mOrder.resize(n);
+  std::iota(mOrder.begin(), mOrder.end(), 0u);
+  std::vector<Vec3> centroids(n);
+  for (std::uint32_t t = 0; t < n; ++t) {
+    const auto& tri = mSurface.triangles[t];
+    centroids[t] = (mSurface.vertices[tri[0]] + mSurface.vertices[tri[1]] + mSurface.vertices[tri[2]]) / 3.0;
+  }
+  mNodes.reserve(2 * (n / kLeafSize + 1));
+  if (n > 0) build(0, n, centroids);
+}
+
+std::int32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, std::vector<Vec3>& centroids) {
+  Node node;
+  node.min = Vec3::Constant(std::numeric_limits<double>::infinity());
+  node.max = -node.min;
+  Vec3 cmin = node.min, cmax = node.max;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    for (std::uint32_t v : mSurface.triangles[mOrder[i]]) {
+      node.min = node.min.cwiseMin(mSurface.vertices[v]);
+      node.max = node.max.cwiseMax(mSurface.vertices[v]);
+    }
+    cmin = cmin.cwiseMin(centroids[mOrder[i]]);
+    cmax = cmax.cwiseMax(centroids[mOrder[i]]);
+  }
+  node.begin = begin;
+  node.end = end;
+  const auto index = static_cast<std::int32_t>(mNodes.size());
+  mNodes.push_back(node);
+  if (end - begin <= kLeafSize) return index;
+  int axis = 0;
+  (cmax - cmin).maxCoeff(&axis);
+  const std::uint32_t mid = begin + (end - begin) / 2;
+  std::nth_element(mOrder.begin() + begin, mOrder.begin() + mid, mOrder.begin() + end,
+                   [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+  const std::int32_t left = build(begin, mid, centroids);
+  const std::int32_t right = build(mid, end, centroids);
+  mNodes[index].left = left;
+  mNodes[index].right = right;
+  return index;
+}
+
+ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p) const {
+  Hit best;
+  double bestSq = std::numeric_limits<double>::infinity();
+  std::array<std::pair<std::int32_t, double>, 64> stack;
+  int top = 0;
+  stack[top++] = {0, boxSquaredDistance(p, mNodes[0].min, mNodes[0].max)};
+  while (top > 0) {
+    const auto [index, boxSq] = stack[--top];
+    if (boxSq >= bestSq) continue;
+    const Node& node = mNodes[index];
+    if (node.left < 0) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        const auto& tri = mSurface.triangles[mOrder[i]];
+        const TrianglePoint q = closestPointOnTriangle(p, mSurface.vertices[tri[0]],
+                                                       mSurface.vertices[tri[1]], mSurface.vertices[tri[2]]);
+        if (q.squaredDistance < bestSq) {
+          bestSq = q.squaredDistance;
+          best = {mOrder[i], q};
+        }
+      }
+      continue;
+    }
+    const Node& l = mNodes[node.left];
+    const Node& r = mNodes[node.right];
+    const double dl = boxSquaredDistance(p, l.min, l.max);
+    const double dr = boxSquaredDistance(p, r.min, r.max);
+    // Nearer child on top of the stack. A median-split tree over 2³² triangles is < 64 deep.
+    if (dl < dr) {
+      stack[top++] = {node.right, dr};
+      stack[top++] = {node.left, dl};
+    } else {
+      stack[top++] = {node.left, dl};
+      stack[top++] = {node.right, dr};
+    }
+  }
+  return best;
+}
+
+TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tets) {
+  const std::size_t n = mTets.size();
+  mInverse.resize(n);
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& x : mNodes) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& k = mTets[t];
+    Mat3 edges;
+    edges << mNodes[k[1]] - mNodes[k[0]], mNodes[k[2]] - mNodes[k[0]], mNodes[k[3]] - mNodes[k[0]];
+    mInverse[t] = edges.inverse();
+  }
+
+  // About two cells per tet, shaped like the bounding box.
+  const Vec3 extent = (hi - lo).cwiseMax(1e-12 * (hi - lo).maxCoeff());
+  const double cell = std::cbrt(extent.prod() / std::max<double>(1.0, 2.0 * static_cast<double>(n)));
+  for (int a = 0; a < 3; ++a)
+    mDims[a] = std::clamp(static_cast<int>(std::ceil(extent[a] / cell)), 1, 256);
+  mOrigin = lo;
+  for (int a = 0; a < 3; ++a)
+    mInvCell[a] = mDims[a] / extent[a];
+  const auto cellRange = [&](const Vec3& p, int a) {
+    return std::clamp(static_cast<int>(std::floor((p[a] - mOrigin[a]) * mInvCell[a])), 0, mDims[a] - 1);
+  };
+  const std::size_t cells = static_cast<std::size_t>(mDims[0]) * mDims[1] * mDims[2];
+  std::vector<std::array<int, 6>> ranges(n);
+  std::vector<std::uint32_t> counts(cells + 1, 0);
+  for (std::size_t t = 0; t < n; ++t) {
+    Vec3 tlo = mNodes[mTets[t][0]], thi = tlo;
+    for (std::uint32_t v : mTets[t]) {
+      tlo = tlo.cwiseMin(mNodes[v]);
+      thi = thi.cwiseMax(mNodes[v]);
+    }
+    auto& r = ranges[t];
+    for (int a = 0; a < 3; ++a) {
+      r[a] = cellRange(tlo, a);
+      r[3 + a] = cellRange(thi, a);
+    }
+    for (int z = r[2]; z <= r[5]; ++z)
+      for (int y = r[1]; y <= r[4]; ++y)
+        for (int x = r[0]; x <= r[3]; ++x)
+          ++counts[(static_cast<std::size_t>(z) * mDims[1] + y) * mDims[0] + x + 1];
+  }
+  std::partial_sum(counts.begin(), counts.end(), counts.begin());
+  mCellBegin = counts;
+  mCellTets.resize(counts.back());
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& r = ranges[t];
+    for (int z = r[2]; z <= r[5]; ++z)
+      for (int y = r[1]; y <= r[4]; ++y)
+        for (int x = r[0]; x <= r[3]; ++x)
+          mCellTets[counts[(static_cast<std::size_t>(z) * mDims[1] + y) * mDims[0] + x]++] =
+              static_cast<std::uint32_t>(t);
+  }
+
+  // Boundary faces: those of one tet only, wound outward (a tet's face opposite vertex i, ordered so
+  // that its normal points away from vertex i).
+  static constexpr std::array<std::array<int, 3>, 4> kFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+  std::map<std::array<std::uint32_t, 3>, std::pair<std::uint32_t, int>> faces;
+  std::vector<std::array<std::uint32_t, 3>> order;
+  for (std::size_t t = 0; t < n; ++t)
+    for (int f = 0; f < 4; ++f) {
+      std::array<std::uint32_t, 3> key{mTets[t][kFaces[f][0]], mTets[t][kFaces[f][1]],
+                                       mTets[t][kFaces[f][2]]};
+      std::sort(key.begin(), key.end());
+      if (const auto it = faces.find(key); it != faces.end()) {
+        faces.erase(it);
+      } else {
+        faces.emplace(key, std::pair{static_cast<std::uint32_t>(t), f});
+        order.push_back(key);
+      }
+    }
+  TriangleMesh boundary;
+  boundary.vertices = mNodes;
+  for (const auto& key : order) {
+    const auto it = faces.find(key);
+    if (it == faces.end()) continue;
+    const auto [t, f] = it->second;
+    boundary.triangles.push_back({mTets[t][kFaces[f][0]], mTets[t][kFaces[f][1]], mTets[t][kFaces[f][2]]});
+    mOwner.push_back(t);
+  }
+  mBoundary = ClosestPointTree(boundary);
+}
+
+std::array<double, 4> TetLocator::weightsIn(std::uint32_t t, const Vec3& p) const {
+  const Vec3 l = mInverse[t] * (p - mNodes[mTets[t][0]]);
+  return {1.0 - l.sum(), l[0], l[1], l[2]};
+}
+
+namespace {
+
+/// Barycentric weights count as inside down to this (they are scale-free).
+constexpr double kInsideTolerance = 1e-10;
+
+double minWeight(const std::array<double, 4>& w) {
+  return std::min(std::min(w[0], w[1]), std::min(w[2], w[3]));
+}
+
+}  // namespace
+
+TetLocation TetLocator::outside(const Vec3& p) const {
+  const ClosestPointTree::Hit hit = mBoundary.closest(p);
+  const std::uint32_t t = mOwner[hit.triangle];
+  return {t, weightsIn(t, hit.closest.point), std::sqrt(hit.closest.squaredDistance)};
+}
+
+TetLocation TetLocator::locate(const Vec3& p) const {
+  std::array<int, 3> c;
+  for (int a = 0; a < 3; ++a) {
+    const double u = (p[a] - mOrigin[a]) * mInvCell[a];
+    if (!(u >= 0.0 && u <= mDims[a])) return outside(p);  // also NaN
+    c[a] = std::min(static_cast<int>(u), mDims[a] - 1);
+  }
+  const std::size_t cell = (static_cast<std::size_t>(c[2]) * mDims[1] + c[1]) * mDims[0] + c[0];
+  double bestMin = -std::numeric_limits<double>::infinity();
+  TetLocation best;
+  for (std::uint32_t i = mCellBegin[cell]; i < mCellBegin[cell + 1]; ++i) {
+    const std::uint32_t t = mCellTets[i];
+    const auto w = weightsIn(t, p);
+    const double m = minWeight(w);
+    if (m > bestMin || (m == bestMin && t < best.tet)) {
+      bestMin = m;
+      best = {t, w, 0.0};
+    }
+  }
+  if (bestMin >= -kInsideTolerance) return best;
+  return outside(p);
+}
+
+TetLocation locateBruteForce(const TetLocator& locator, const Vec3& p) {
+  double bestMin = -std::numeric_limits<double>::infinity();
+  TetLocation best;
+  for (std::uint32_t t = 0; t < locator.mTets.size(); ++t) {
+    const auto w = locator.weightsIn(t, p);
+    const double m = minWeight(w);
+    if (m > bestMin) {
+      bestMin = m;
+      best = {t, w, 0.0};
+    }
+  }
+  if (bestMin >= -kInsideTolerance) return best;
+  const TriangleMesh& boundary = locator.boundary();
+  double bestSq = std::numeric_limits<double>::infinity();
+  std::uint32_t face = 0;
+  TrianglePoint closest;
+  for (std::uint32_t f = 0; f < boundary.triangles.size(); ++f) {
+    const auto& tri = boundary.triangles[f];
+    const TrianglePoint q = closestPointOnTriangle(p, boundary.vertices[tri[0]], boundary.vertices[tri[1]],
+                                                   boundary.vertices[tri[2]]);
+    if (q.squaredDistance < bestSq) {
+      bestSq = q.squaredDistance;
+      face = f;
+      closest = q;
+    }
+  }
+  const std::uint32_t t = locator.mOwner[face];
+  return {t, locator.weightsIn(t, closest.point), std::sqrt(bestSq)};
+}
+
+}  // namespace shapedb::core
