@@ -1,0 +1,102 @@
+#pragma once
+// Adaptation (paper §5, DESIGN.md "Adaptation"): a database entry's physical data, stored in its
+// canonical frame for unit volume, density and Young's modulus, carried to the query's frame, size and
+// material. And linking (paper eq. 7): the query's surface vertices embedded in the adapted tets.
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/normalize.h>
+#include <shapedb/core/physics.h>
+#include <shapedb/core/result.h>
+#include <shapedb/core/spatial.h>
+#include <shapedb/core/types.h>
+
+namespace shapedb::core {
+
+/// An isotropic linear elastic material, SI units.
+struct Material {
+  std::string name;            ///< a preset's name, or "custom"
+  double density = 0.0;        ///< ρ, kg/m³
+  double youngsModulus = 0.0;  ///< E, Pa
+  double poissonRatio = 0.0;   ///< ν, in (−1, 0.5)
+};
+
+/// steel, aluminium, glass, wood, rubber, concrete: textbook room-temperature values (wood: along the
+/// grain, as an isotropic stand-in; rubber: small-strain modulus).
+std::span<const Material> materialPresets();
+/// A preset by name (case-insensitive; "aluminum" also accepted). Errors: kInvalidArgument naming the
+/// presets.
+Result<Material> materialPreset(std::string_view name);
+/// Errors: kInvalidArgument if ρ or E is not finite and positive or ν is outside (−1, 0.5).
+Status validateMaterial(const Material& material);
+
+/// Where an entry's canonical frame lands in the query's frame: p = translation + scale · rotation · e.
+/// For a query normalized by T (p' = s Rᵀ (p − c)) and matched in orientation O (the entry's canonical
+/// frame is O times the query's): rotation = R Oᵀ, translation = c, scale = L = 1/s = V^(1/3).
+struct Placement {
+  Mat3 rotation = Mat3::Identity();
+  Vec3 translation = Vec3::Zero();
+  double scale = 1.0;
+  Vec3 toQuery(const Vec3& e) const { return translation + scale * (rotation * e); }
+  Vec3 toEntry(const Vec3& p) const { return rotation.transpose() * (p - translation) / scale; }
+};
+Placement placementOf(const Normalization& query, const Mat3& orientation);
+
+/// An entry's physical data in the query's frame, size and material.
+struct AdaptedPhysics {
+  Material material;
+  Placement placement;
+  TetMesh tetMesh;                ///< nodes in the query's frame, metres
+  MassProperties massProperties;  ///< the query's own (exact, from its surface) at the material's density
+  /// The entry's tets as placed: what the retrieved data assume. Compare with massProperties.
+  MassProperties entryMassProperties;
+  Eigen::VectorXd eigenvalues;  ///< ω², (rad/s)², ascending: ω = sqrt(E/ρ) ω' / L
+  /// 3·nodes × modes, in the query's frame, M-orthonormal for the mass matrix of tetMesh at the
+  /// material's density: φ = R φ' / sqrt(ρ L³).
+  Eigen::MatrixXd modeShapes;
+  CollisionCompound collision;  ///< shapes in the query's frame; coverage and overshoot are the entry's
+  RayleighDamping damping;      ///< the database's, applied to the adapted frequencies
+  std::vector<std::string> warnings;
+
+  Eigen::VectorXd frequenciesHz() const;  ///< ω / 2π
+  Eigen::VectorXd dampingRatios() const;  ///< ζ per mode
+};
+
+/// Adapts `entry` to a query with normalization `query` (its exact mass properties at unit density in
+/// `queryMass`) matched in orientation `orientation` (Match::orientation). A material whose Poisson
+/// ratio differs from the database's by more than 0.01 adds a warning: the mode shapes and the ratios
+/// of the frequencies are those of the database's ratio. Errors: validateMaterial's; kInvalidArgument for
+/// an entry whose modes do not fit its tet mesh.
+Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& query,
+                             const MassProperties& queryMass, const Mat3& orientation,
+                             const Material& material, const RayleighDamping& damping);
+
+/// Linking (paper eq. 7): per surface vertex, the adapted tet that holds it and its four barycentric
+/// weights (≥ 0, summing to 1). A vertex outside every tet is tied to the closest point of the tet
+/// mesh's boundary, in the tet that owns it.
+struct SurfaceLink {
+  std::vector<TetLocation> locations;  ///< per vertex
+  std::size_t outsideCount = 0;
+  double maxOutsideDistance = 0.0;  ///< metres
+};
+
+/// Links `vertices` (the query's, in its frame) to the entry's tets through `locator`, built on the
+/// entry's canonical tet mesh: the vertices are carried to the entry's frame by `placement`, so one
+/// locator serves every query that matches the entry. Distances are reported in the query's units.
+/// Parallel (TBB) above a few thousand vertices.
+SurfaceLink linkSurface(const TetLocator& locator, const Placement& placement,
+                        std::span<const Vec3> vertices);
+
+/// Deformed positions of linked vertices: x = rest + Σ wᵢ u(nodeᵢ), with u the node displacements
+/// (3 per node, query frame). Inside vertices thus move with the tet's linear interpolation; outside
+/// vertices with their closest point. `out` is resized to rest.size().
+void deformSurface(const SurfaceLink& link, const TetMesh& tetMesh,
+                   const Eigen::Ref<const Eigen::VectorXd>& u, std::span<const Vec3> rest,
+                   std::vector<Vec3>& out);
+
+}  // namespace shapedb::core

@@ -1,0 +1,175 @@
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+#include <tbb/parallel_for.h>
+
+#include <shapedb/core/adapt.h>
+
+namespace shapedb::core {
+
+namespace {
+
+const std::array<Material, 6> kPresets{{
+    {"steel", 7850.0, 200e9, 0.30},
+    {"aluminium", 2700.0, 69e9, 0.33},
+    {"glass", 2500.0, 70e9, 0.22},
+    {"wood", 700.0, 11e9, 0.35},
+    {"rubber", 1100.0, 0.05e9, 0.49},
+    {"concrete", 2400.0, 30e9, 0.20},
+}};
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+}  // namespace
+
+std::span<const Material> materialPresets() {
+  return kPresets;
+}
+
+Result<Material> materialPreset(std::string_view name) {
+  std::string key = lower(name);
+  if (key == "aluminum") key = "aluminium";
+  for (const Material& m : kPresets)
+    if (m.name == key) return m;
+  std::string names;
+  for (const Material& m : kPresets)
+    names += (names.empty() ? "" : ", ") + m.name;
+  return Error{ErrorCode::kInvalidArgument,
+               "unknown material '" + std::string(name) + "' (presets: " + names + ")"};
+}
+
+Status validateMaterial(const Material& m) {
+  if (!(std::isfinite(m.density) && m.density > 0.0))
+    return Error{ErrorCode::kInvalidArgument, "density must be finite and > 0 kg/m³"};
+  if (!(std::isfinite(m.youngsModulus) && m.youngsModulus > 0.0))
+    return Error{ErrorCode::kInvalidArgument, "Young's modulus must be finite and > 0 Pa"};
+  if (!(m.poissonRatio > -1.0 && m.poissonRatio < 0.5))
+    return Error{ErrorCode::kInvalidArgument, "Poisson ratio must lie in (-1, 0.5)"};
+  return Ok{};
+}
+
+Placement placementOf(const Normalization& query, const Mat3& orientation) {
+  return {query.principalAxes * orientation.transpose(), query.meshFromCanonical.topRightCorner<3, 1>(),
+          1.0 / query.scale};
+}
+
+Eigen::VectorXd AdaptedPhysics::frequenciesHz() const {
+  return eigenvalues.cwiseSqrt() / (2.0 * std::numbers::pi);
+}
+
+Eigen::VectorXd AdaptedPhysics::dampingRatios() const {
+  Eigen::VectorXd z(eigenvalues.size());
+  for (Eigen::Index i = 0; i < z.size(); ++i)
+    z[i] = damping.dampingRatio(std::sqrt(eigenvalues[i]));
+  return z;
+}
+
+Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& query,
+                             const MassProperties& queryMass, const Mat3& orientation,
+                             const Material& material, const RayleighDamping& damping) {
+  if (Status valid = validateMaterial(material); !valid) return valid.error();
+  const std::size_t nodes = entry.tetMesh.nodeCount();
+  if (entry.modes.shapes.rows() != static_cast<Eigen::Index>(3 * nodes) ||
+      entry.modes.shapes.cols() != entry.modes.eigenvalues.size())
+    return Error{ErrorCode::kInvalidArgument, "entry's mode shapes do not fit its tet mesh"};
+
+  AdaptedPhysics out;
+  out.material = material;
+  out.placement = placementOf(query, orientation);
+  out.damping = damping;
+  const Placement& P = out.placement;
+  const double L = P.scale, rho = material.density;
+
+  out.tetMesh.tets = entry.tetMesh.tets;
+  out.tetMesh.nodes.resize(nodes);
+  for (std::size_t i = 0; i < nodes; ++i)
+    out.tetMesh.nodes[i] = P.toQuery(entry.tetMesh.nodes[i]);
+
+  out.massProperties = queryMass;
+  out.massProperties.density = rho;
+  out.massProperties.mass = rho * queryMass.volume;
+  out.massProperties.inertia = queryMass.inertia * (rho / queryMass.density);
+
+  // Mass scales with ρL³, inertia with ρL⁵, both rotated into the query's frame.
+  const MassProperties& e = entry.massProperties;
+  out.entryMassProperties = e;
+  out.entryMassProperties.density = rho;
+  out.entryMassProperties.volume = e.volume * L * L * L;
+  out.entryMassProperties.mass = rho * out.entryMassProperties.volume;
+  out.entryMassProperties.area = e.area * L * L;
+  out.entryMassProperties.centerOfMass = P.toQuery(e.centerOfMass);
+  out.entryMassProperties.inertia =
+      P.rotation * e.inertia * P.rotation.transpose() * (rho / e.density) * std::pow(L, 5);
+
+  // K scales with E·L, M with ρ·L³: λ = (E / ρL²) λ'. φ keeps φᵀMφ = 1 with φ = R φ' / sqrt(ρL³).
+  out.eigenvalues = entry.modes.eigenvalues * (material.youngsModulus / (rho * L * L));
+  const double shapeScale = 1.0 / std::sqrt(rho * L * L * L);
+  const Eigen::Index m = entry.modes.shapes.cols();
+  out.modeShapes.resize(entry.modes.shapes.rows(), m);
+  const Mat3 R = P.rotation * shapeScale;
+  for (Eigen::Index j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < nodes; ++i)
+      out.modeShapes.col(j).segment<3>(3 * static_cast<Eigen::Index>(i)) =
+          R * entry.modes.shapes.col(j).segment<3>(3 * static_cast<Eigen::Index>(i));
+
+  out.collision = entry.collision;
+  for (CollisionShape& s : out.collision.shapes) {
+    s.center = P.toQuery(s.center);
+    s.rotation = P.rotation * s.rotation;
+    s.halfExtents *= L;
+    s.radius *= L;
+    s.halfLength *= L;
+  }
+
+  if (std::abs(material.poissonRatio - entry.modes.poissonRatio) > 0.01)
+    out.warnings.push_back("material Poisson ratio " + std::to_string(material.poissonRatio) +
+                           " differs from the database's " + std::to_string(entry.modes.poissonRatio) +
+                           ": mode shapes and frequency ratios are the database's");
+  return out;
+}
+
+SurfaceLink linkSurface(const TetLocator& locator, const Placement& placement,
+                        std::span<const Vec3> vertices) {
+  SurfaceLink link;
+  link.locations.resize(vertices.size());
+  const auto one = [&](std::size_t i) { link.locations[i] = locator.locate(placement.toEntry(vertices[i])); };
+  if (vertices.size() >= 4096) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 1024), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i)
+        one(i);
+    });
+  } else {
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+      one(i);
+  }
+  for (TetLocation& l : link.locations)
+    if (!l.inside()) {
+      l.distance *= placement.scale;
+      ++link.outsideCount;
+      link.maxOutsideDistance = std::max(link.maxOutsideDistance, l.distance);
+    }
+  return link;
+}
+
+void deformSurface(const SurfaceLink& link, const TetMesh& tetMesh,
+                   const Eigen::Ref<const Eigen::VectorXd>& u, std::span<const Vec3> rest,
+                   std::vector<Vec3>& out) {
+  out.resize(rest.size());
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    const TetLocation& l = link.locations[i];
+    Vec3 x = rest[i];
+    for (int k = 0; k < 4; ++k)
+      x += l.weights[k] * u.segment<3>(3 * static_cast<Eigen::Index>(tetMesh.tets[l.tet][k]));
+    out[i] = x;
+  }
+}
+
+}  // namespace shapedb::core
