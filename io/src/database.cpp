@@ -7,6 +7,7 @@
 #include <set>
 #include <unordered_map>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
@@ -225,16 +226,36 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
   return ids;
 }
 
+namespace {
+
+/// What the cache keeps per entry: its physical data and the locator built on its tets.
+struct CachedEntry {
+  core::PhysicalData data;
+  core::TetLocator locator;
+};
+
+using Describers = std::array<std::unique_ptr<volume::Describer>, 3>;
+
+double microsecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+}  // namespace
+
 struct Database::Impl {
   explicit Impl(Store s) : store(std::move(s)) {}
+  Result<std::shared_ptr<const CachedEntry>> cachedEntry(core::EntryId id);
+  volume::Describer& describer(core::DescriptorKind kind);
+
   Store store;
+  /// One Describer per thread and kind: describing reuses its grid's memory instead of allocating.
+  tbb::enumerable_thread_specific<Describers> describers;
   std::vector<EntryRecord> entries;
   std::unordered_map<core::EntryId, std::size_t> byId;
   std::array<std::optional<core::Index>, 3> indexes;
   std::size_t cacheCapacity = 64;
   mutable std::mutex cacheMutex;
-  mutable std::list<std::pair<core::EntryId, std::shared_ptr<const core::PhysicalData>>>
-      lru;  // front: newest
+  mutable std::list<std::pair<core::EntryId, std::shared_ptr<const CachedEntry>>> lru;  // front: newest
   mutable std::unordered_map<core::EntryId, decltype(lru)::iterator> cached;
   mutable std::size_t hits = 0, misses = 0;
 };
@@ -298,44 +319,145 @@ const core::Index& Database::index(core::DescriptorKind kind) const {
   return *mImpl->indexes[static_cast<std::size_t>(kind)];
 }
 
+volume::Describer& Database::Impl::describer(core::DescriptorKind kind) {
+  std::unique_ptr<volume::Describer>& slot = describers.local()[static_cast<std::size_t>(kind)];
+  if (!slot) {
+    core::DescriptorOptions o = store.parameters().entry.descriptor;
+    o.kind = kind;
+    slot = std::make_unique<volume::Describer>(o);
+  }
+  return *slot;
+}
+
+Result<std::shared_ptr<const CachedEntry>> Database::Impl::cachedEntry(core::EntryId id) {
+  {
+    std::lock_guard lock(cacheMutex);
+    if (const auto it = cached.find(id); it != cached.end()) {
+      lru.splice(lru.begin(), lru, it->second);
+      ++hits;
+      return it->second->second;
+    }
+    ++misses;
+  }
+  // Read outside the lock: two threads missing the same entry both read it, and the first insert wins.
+  auto data = store.physics(id);
+  if (!data) return data.error();
+  auto entry = std::make_shared<CachedEntry>();
+  entry->data = std::move(data).value();
+  entry->locator = core::TetLocator(entry->data.tetMesh);
+  std::lock_guard lock(cacheMutex);
+  if (const auto it = cached.find(id); it != cached.end()) return it->second->second;
+  lru.emplace_front(id, std::move(entry));
+  cached[id] = lru.begin();
+  std::shared_ptr<const CachedEntry> result = lru.front().second;
+  while (lru.size() > cacheCapacity) {
+    cached.erase(lru.back().first);
+    lru.pop_back();
+  }
+  return result;
+}
+
 Result<std::vector<core::Match>> Database::match(const core::TriangleMesh& mesh, core::DescriptorKind kind,
                                                  const core::SearchOptions& search) const {
+  QueryOptions options;
+  options.descriptor = kind;
+  options.search = search;
+  options.adapt = false;
+  options.fidelity = false;
+  auto result = query(mesh, options);
+  if (!result) return result.error();
+  std::vector<core::Match> matches;
+  for (const MatchReport& m : result->matches)
+    matches.push_back(m.match);
+  return matches;
+}
+
+Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryOptions& options) const {
+  const Clock::time_point start = Clock::now();
+  QueryResult out;
+  if (options.adapt)
+    if (Status valid = core::validateMaterial(options.material); !valid) return valid.error();
+
+  Clock::time_point t = Clock::now();
   if (Status valid = core::validateMesh(mesh); !valid) return valid.error();
   auto mass = core::computeMassProperties(mesh);
   if (!mass) return mass.error();
+  out.massProperties = *mass;
   auto normalization = core::normalize(mesh, *mass);
   if (!normalization) return normalization.error();
-  core::DescriptorOptions o = parameters().entry.descriptor;
-  o.kind = kind;
-  volume::Describer describer(o);
-  auto candidates = describer.describeCandidates(mesh, *normalization);
+  out.normalization = *normalization;
+  out.times.massProperties = microsecondsSince(t);
+
+  t = Clock::now();
+  auto candidates =
+      mImpl->describer(options.descriptor).describeCandidates(mesh, out.normalization, options.orientation);
   if (!candidates) return candidates.error();
-  return index(kind).search(*candidates, search);
+  out.times.describe = microsecondsSince(t);
+
+  t = Clock::now();
+  auto matches = index(options.descriptor).search(*candidates, options.search);
+  if (!matches) return matches.error();
+  out.times.search = microsecondsSince(t);
+  for (const core::Match& m : *matches)
+    out.matches.push_back({m, entry(m.entry), std::nullopt});
+  if (out.matches.empty() || (!options.adapt && !options.fidelity)) {
+    out.times.total = microsecondsSince(start);
+    return out;
+  }
+
+  t = Clock::now();
+  std::vector<std::shared_ptr<const CachedEntry>> entries;
+  const std::size_t fetchCount = options.fidelity ? out.matches.size() : 1;
+  for (std::size_t i = 0; i < fetchCount; ++i) {
+    auto e = mImpl->cachedEntry(out.matches[i].match.entry);
+    if (!e) return e.error();
+    entries.push_back(std::move(e).value());
+  }
+  out.times.fetch = microsecondsSince(t);
+  const CachedEntry& best = *entries.front();
+  out.entryPhysics = std::shared_ptr<const core::PhysicalData>(entries.front(), &best.data);
+
+  if (options.adapt) {
+    t = Clock::now();
+    auto adapted =
+        core::adapt(best.data, out.normalization, out.massProperties, out.matches.front().match.orientation,
+                    options.material, parameters().entry.damping);
+    if (!adapted) return adapted.error();
+    out.physics = std::move(adapted).value();
+    out.times.adapt = microsecondsSince(t);
+    if (options.link) {
+      t = Clock::now();
+      out.link = core::linkSurface(best.locator, out.physics->placement, mesh.vertices);
+      out.times.link = microsecondsSince(t);
+    }
+  }
+
+  if (options.fidelity) {
+    t = Clock::now();
+    const core::ClosestPointTree queryTree(mesh);
+    for (std::size_t i = 0; i < out.matches.size(); ++i) {
+      MatchReport& m = out.matches[i];
+      const core::Placement placement = core::placementOf(out.normalization, m.match.orientation);
+      m.fidelity = core::assessFidelity(mesh, queryTree, out.normalization, entries[i]->locator,
+                                        entries[i]->data.massProperties, placement, m.match.distance,
+                                        options.fidelityOptions);
+    }
+    out.times.fidelity = microsecondsSince(t);
+  }
+  out.times.total = microsecondsSince(start);
+  return out;
 }
 
 Result<std::shared_ptr<const core::PhysicalData>> Database::physics(core::EntryId id) const {
-  {
-    std::lock_guard lock(mImpl->cacheMutex);
-    if (const auto it = mImpl->cached.find(id); it != mImpl->cached.end()) {
-      mImpl->lru.splice(mImpl->lru.begin(), mImpl->lru, it->second);
-      ++mImpl->hits;
-      return it->second->second;
-    }
-    ++mImpl->misses;
-  }
-  // Read outside the lock: two threads missing the same entry both read it, and the second insert wins.
-  auto data = mImpl->store.physics(id);
-  if (!data) return data.error();
-  auto shared = std::make_shared<const core::PhysicalData>(std::move(data).value());
-  std::lock_guard lock(mImpl->cacheMutex);
-  if (const auto it = mImpl->cached.find(id); it != mImpl->cached.end()) return it->second->second;
-  mImpl->lru.emplace_front(id, shared);
-  mImpl->cached[id] = mImpl->lru.begin();
-  while (mImpl->lru.size() > mImpl->cacheCapacity) {
-    mImpl->cached.erase(mImpl->lru.back().first);
-    mImpl->lru.pop_back();
-  }
-  return shared;
+  auto e = mImpl->cachedEntry(id);
+  if (!e) return e.error();
+  return std::shared_ptr<const core::PhysicalData>(*e, &(*e)->data);
+}
+
+Result<std::shared_ptr<const core::TetLocator>> Database::locator(core::EntryId id) const {
+  auto e = mImpl->cachedEntry(id);
+  if (!e) return e.error();
+  return std::shared_ptr<const core::TetLocator>(*e, &(*e)->locator);
 }
 
 std::array<std::size_t, 2> Database::cacheStats() const {

@@ -1,8 +1,10 @@
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -120,6 +122,109 @@ TEST_F(SmallDatabase, PhysicsReadBackMatchesAFreshComputation) {
   // The second read comes from the cache.
   ASSERT_TRUE(db->physics(e.id).ok());
   EXPECT_EQ(db->cacheStats()[0], 1u);
+}
+
+TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerysSizeAndMaterial) {
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  std::mt19937_64 rng(77);
+  const core::Material glass = *core::materialPreset("glass");
+  for (std::size_t i = 0; i < db->entries().size(); i += 3) {  // one entry of each family
+    const EntryRecord& e = db->entries()[i];
+    const volume::ShapeSpec spec = volume::familySpec(
+        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    auto surface = volume::makeFamilyShape(spec, db->parameters().resolution);
+    ASSERT_TRUE(surface.ok());
+    const core::TriangleMesh query =
+        core::transformed(*surface, test::randomSimilarity(rng, 10.0, 0.05, 20.0));
+    QueryOptions options;
+    options.material = glass;
+    options.search.k = 2;
+    auto r = db->query(query, options);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ASSERT_EQ(r->matches.size(), 2u);
+    EXPECT_EQ(r->matches[0].match.entry, e.id) << e.name;
+    ASSERT_TRUE(r->matches[0].fidelity && r->matches[1].fidelity);
+    const core::Fidelity& f = *r->matches[0].fidelity;
+    EXPECT_LT(f.descriptorDistance, 1e-6) << e.name;
+    EXPECT_LT(f.maxMomentError, 1e-6) << e.name;
+    EXPECT_LT(f.maxDeviation, 1e-6) << e.name << ": the placed tets' boundary is the query's surface";
+    EXPECT_GT(r->matches[1].fidelity->meanDeviation, f.meanDeviation) << e.name;
+
+    // Scaling laws against the query's own size L and the material.
+    ASSERT_TRUE(r->physics.has_value());
+    const core::AdaptedPhysics& p = *r->physics;
+    const double L = std::cbrt(r->massProperties.volume);
+    EXPECT_NEAR(p.massProperties.mass / (glass.density * r->massProperties.volume), 1.0, 1e-12);
+    EXPECT_NEAR(p.entryMassProperties.mass / p.massProperties.mass, 1.0, 1e-6) << e.name;
+    const Eigen::VectorXd expected =
+        r->entryPhysics->modes.frequenciesHz() * std::sqrt(glass.youngsModulus / glass.density) / L;
+    ASSERT_EQ(p.frequenciesHz().size(), expected.size());
+    for (Eigen::Index m = 0; m < expected.size(); ++m)
+      EXPECT_NEAR(p.frequenciesHz()[m] / expected[m], 1.0, 1e-12);
+    // Independently of the scaling code: FEM assembled on the adapted tets in the query's frame and
+    // units. The stored shapes are 16-bit per mode, so orthonormality and the Rayleigh quotients hold
+    // to ~1e-3, not round-off.
+    const volume::FemMatrices fem = volume::assembleFem(
+        p.tetMesh, {.youngsModulus = glass.youngsModulus, .poissonRatio = 0.3, .density = glass.density});
+    const Eigen::Index modes = p.modeShapes.cols();
+    const Eigen::MatrixXd gram = p.modeShapes.transpose() * fem.mass * p.modeShapes;
+    EXPECT_LT((gram - Eigen::MatrixXd::Identity(modes, modes)).cwiseAbs().maxCoeff(), 2e-3) << e.name;
+    const Eigen::MatrixXd stiff = p.modeShapes.transpose() * fem.stiffness * p.modeShapes;
+    for (Eigen::Index m = 0; m < modes; ++m)
+      EXPECT_NEAR(stiff(m, m) / p.eigenvalues[m], 1.0, 2e-3) << e.name << " mode " << m;
+
+    // Linking: every vertex of the query lies on the placed tets' boundary.
+    ASSERT_EQ(r->link.locations.size(), query.vertexCount());
+    for (std::size_t v = 0; v < query.vertexCount(); ++v) {
+      const core::TetLocation& l = r->link.locations[v];
+      ASSERT_NEAR(l.weights[0] + l.weights[1] + l.weights[2] + l.weights[3], 1.0, 1e-12);
+      core::Vec3 x = core::Vec3::Zero();
+      for (int k = 0; k < 4; ++k)
+        x += l.weights[k] * p.tetMesh.nodes[p.tetMesh.tets[l.tet][k]];
+      ASSERT_LT((x - query.vertices[v]).norm(), 1e-9 * L) << e.name << " vertex " << v;
+    }
+    EXPECT_LT(r->link.maxOutsideDistance, 1e-9 * L);
+  }
+}
+
+TEST_F(SmallDatabase, ConcurrentQueriesAgreeWithSerialOnes) {
+  Database::OpenOptions small;
+  small.cacheEntries = 4;
+  auto db = Database::open(sPath, small);
+  ASSERT_TRUE(db.ok());
+  std::mt19937_64 rng(5);
+  std::vector<core::TriangleMesh> queries;
+  for (const EntryRecord& e : db->entries()) {
+    const volume::ShapeSpec spec = volume::familySpec(
+        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    queries.push_back(core::transformed(*volume::makeFamilyShape(spec, db->parameters().resolution),
+                                        test::randomSimilarity(rng, 3.0, 0.5, 2.0)));
+  }
+  std::vector<core::EntryId> serial;
+  std::vector<double> serialHz;
+  for (const auto& q : queries) {
+    auto r = db->query(q);
+    ASSERT_TRUE(r.ok());
+    serial.push_back(r->matches[0].match.entry);
+    serialHz.push_back(r->physics->frequenciesHz()[0]);
+  }
+  // Four threads, each querying every mesh in its own order, through a cache smaller than the set.
+  std::vector<std::thread> threads;
+  std::atomic<int> mismatches{0};
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (std::size_t n = 0; n < 3 * queries.size(); ++n) {
+        const std::size_t i = (n * (2 * t + 1) + static_cast<std::size_t>(t)) % queries.size();
+        auto r = db->query(queries[i]);
+        if (!r.ok() || r->matches[0].match.entry != serial[i] ||
+            r->physics->frequenciesHz()[0] != serialHz[i])
+          ++mismatches;
+      }
+    });
+  for (auto& t : threads)
+    t.join();
+  EXPECT_EQ(mismatches.load(), 0);
 }
 
 TEST_F(SmallDatabase, OtherDescriptorParametersAreAClearError) {

@@ -9,7 +9,10 @@
 #include <string>
 #include <vector>
 
+#include <shapedb/core/adapt.h>
+#include <shapedb/core/fidelity.h>
 #include <shapedb/core/index.h>
+#include <shapedb/core/orientation.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
 #include <shapedb/core/triangle_mesh.h>
@@ -64,6 +67,50 @@ struct NamedMesh {
 Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& path,
                                                  std::span<const NamedMesh> meshes);
 
+/// What Database::query does beyond matching.
+struct QueryOptions {
+  core::DescriptorKind descriptor = core::DescriptorKind::kCentroidVoxel;
+  core::SearchOptions search;  ///< k, method
+  core::OrientationOptions orientation;
+  core::Material material = core::materialPresets()[0];  ///< steel
+  /// Fetch the best match's physical data, adapt it to the query (size, frame, material) and link the
+  /// query's vertices to its tets. false: matching only.
+  bool adapt = true;
+  bool link = true;      ///< with adapt
+  bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
+  core::FidelityOptions fidelityOptions;
+};
+
+/// Wall time of each stage of one query, microseconds.
+struct QueryTimes {
+  double massProperties = 0.0;  ///< validate + exact mass properties + normalize
+  double describe = 0.0;        ///< every orientation candidate
+  double search = 0.0;
+  double fetch = 0.0;  ///< physical data from the cache or the file (with the entry's locator)
+  double adapt = 0.0;
+  double link = 0.0;
+  double fidelity = 0.0;
+  double total = 0.0;
+};
+
+struct MatchReport {
+  core::Match match;
+  const EntryRecord* entry = nullptr;  ///< owned by the Database
+  std::optional<core::Fidelity> fidelity;
+};
+
+/// Everything a query found: the query's own mass properties (unit density) and frame, the k best
+/// matches best first, and for the best one its physical data adapted to the query and linked to it.
+struct QueryResult {
+  core::MassProperties massProperties;
+  core::Normalization normalization;
+  std::vector<MatchReport> matches;
+  std::shared_ptr<const core::PhysicalData> entryPhysics;  ///< the best match's, canonical frame
+  std::optional<core::AdaptedPhysics> physics;             ///< with QueryOptions::adapt
+  core::SurfaceLink link;                                  ///< with QueryOptions::link
+  QueryTimes times;
+};
+
 /// An open database: every entry's descriptors in three in-RAM indexes (one per kind), its physical data
 /// read on demand through a bounded cache. Thread-safe: concurrent searches and physics reads.
 class Database {
@@ -93,8 +140,16 @@ class Database {
   Result<std::vector<core::Match>> match(const core::TriangleMesh& mesh, core::DescriptorKind kind,
                                          const core::SearchOptions& search = {}) const;
 
+  /// Algorithm 1 of the paper, whole: match `mesh` (any frame, any size; closed and oriented), then
+  /// fetch, adapt and link the best match and report the fidelity of every match. Thread-safe: many
+  /// threads may query at once (each keeps its own descriptor scratch).
+  /// Errors: the mesh's (validateMesh, computeMassProperties: open or degenerate surfaces), the
+  /// material's, Store::physics's.
+  Result<QueryResult> query(const core::TriangleMesh& mesh, const QueryOptions& options = {}) const;
   /// One entry's physical data, from the cache or the file. Errors: Store::physics's.
   Result<std::shared_ptr<const core::PhysicalData>> physics(core::EntryId id) const;
+  /// One entry's point locator (its tets and their boundary), built once per cached entry.
+  Result<std::shared_ptr<const core::TetLocator>> locator(core::EntryId id) const;
   /// Cache statistics: hits and misses since open.
   std::array<std::size_t, 2> cacheStats() const;
 

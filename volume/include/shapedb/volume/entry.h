@@ -23,7 +23,8 @@ struct EntryOptions {
   TetrahedralizeOptions tetgen;
   ModalOptions modal;  ///< modes and Poisson ratio; E = ρ = 1 always
   CollisionOptions collision;
-  core::RayleighDamping damping{.alpha = 2.0, .beta = 1e-6};  ///< for the sound data, at unit material
+  core::RayleighDamping damping{
+      .alpha = 2.0, .beta = 1e-6};  ///< for the sound data: α (1/s), β (s), applied to adapted frequencies
 };
 
 /// Wall time of each stage of computeEntry, seconds.
