@@ -27,6 +27,7 @@ Command addDescribeCommand(CLI::App& parent);
 Command addBuildCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addAddCommand(CLI::App& parent);
+Command addQueryCommand(CLI::App& parent);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);

@@ -1,0 +1,322 @@
+// shapedb query: mesh files in, matches and adapted physical data out (paper Algorithm 1).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <shapedb/core/descriptor.h>
+#include <shapedb/io/database.h>
+#include <shapedb/io/mesh_io.h>
+#include <shapedb/io/render.h>
+#include <shapedb/volume/families.h>
+
+#include "commands.h"
+#include "format.h"
+
+namespace shapedb::cli {
+namespace {
+
+struct QueryCommandOptions {
+  std::string database;
+  std::vector<std::string> meshes;
+  int k = 1;
+  std::string descriptor = "centroid-voxel";
+  std::string method = "pruned";
+  std::string material = "steel";
+  double density = 0.0, youngs = 0.0, poisson = 0.0;
+  bool json = false;
+  bool timing = false;
+  bool noFidelity = false;
+  std::string exportDir;
+  std::string png;
+};
+
+nlohmann::json matchJson(const io::MatchReport& m) {
+  nlohmann::json out = {{"entry_id", m.match.entry},
+                        {"name", m.entry ? m.entry->name : ""},
+                        {"family", m.entry ? volume::toString(m.entry->family) : ""},
+                        {"distance", m.match.distance}};
+  if (m.fidelity) {
+    const core::Fidelity& f = *m.fidelity;
+    out["fidelity"] = {{"descriptor_distance", f.descriptorDistance},
+                       {"query_moments", toJson(f.queryMoments)},
+                       {"entry_moments", toJson(f.entryMoments)},
+                       {"moment_error", toJson(f.momentError)},
+                       {"max_moment_error", f.maxMomentError},
+                       {"mean_deviation", f.meanDeviation},
+                       {"max_deviation", f.maxDeviation},
+                       {"samples", f.samples}};
+  }
+  return out;
+}
+
+nlohmann::json physicsJson(const core::AdaptedPhysics& p) {
+  nlohmann::json collision = nlohmann::json::array();
+  for (const core::CollisionShape& s : p.collision.shapes) {
+    nlohmann::json shape = {
+        {"type", core::toString(s.type)}, {"center", toJson(s.center)}, {"rotation", toJson(s.rotation)}};
+    if (s.type == core::CollisionShape::Type::kBox) shape["half_extents"] = toJson(s.halfExtents);
+    if (s.type != core::CollisionShape::Type::kBox) shape["radius"] = s.radius;
+    if (s.type == core::CollisionShape::Type::kCapsule) shape["half_length"] = s.halfLength;
+    collision.push_back(std::move(shape));
+  }
+  const Eigen::SelfAdjointEigenSolver<core::Mat3> principal(p.massProperties.inertia, Eigen::EigenvaluesOnly);
+  return {{"material",
+           {{"name", p.material.name},
+            {"density", p.material.density},
+            {"youngs_modulus", p.material.youngsModulus},
+            {"poisson_ratio", p.material.poissonRatio}}},
+          {"mass", p.massProperties.mass},
+          {"volume", p.massProperties.volume},
+          {"center_of_mass", toJson(p.massProperties.centerOfMass)},
+          {"inertia", toJson(p.massProperties.inertia)},
+          {"principal_moments", toJson(principal.eigenvalues())},
+          {"entry_mass", p.entryMassProperties.mass},
+          {"frequencies_hz", toJson(p.frequenciesHz())},
+          {"damping_ratios", toJson(p.dampingRatios())},
+          {"tet_nodes", p.tetMesh.nodeCount()},
+          {"tets", p.tetMesh.tetCount()},
+          {"collision",
+           {{"shapes", collision}, {"coverage", p.collision.coverage}, {"overshoot", p.collision.overshoot}}},
+          {"warnings", p.warnings}};
+}
+
+nlohmann::json timingJson(const io::QueryTimes& t) {
+  return {{"mass_properties", t.massProperties},
+          {"describe", t.describe},
+          {"search", t.search},
+          {"fetch", t.fetch},
+          {"adapt", t.adapt},
+          {"link", t.link},
+          {"fidelity", t.fidelity},
+          {"total", t.total}};
+}
+
+std::string percent(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f%%", 100.0 * x);
+  return b;
+}
+
+void printText(const std::string& file, const core::TriangleMesh& mesh, const io::QueryResult& r,
+               bool timing) {
+  std::printf("%s: %zu triangles, volume %.6g m³, size L = %.6g m\n", file.c_str(), mesh.triangleCount(),
+              r.massProperties.volume, std::cbrt(r.massProperties.volume));
+  std::printf("  %-4s %-16s %-10s %12s %12s %12s %12s\n", "rank", "entry", "family", "distance", "moment err",
+              "dev. mean", "dev. max");
+  for (std::size_t i = 0; i < r.matches.size(); ++i) {
+    const io::MatchReport& m = r.matches[i];
+    std::printf("  %-4zu %-16s %-10s %12.6g", i + 1, m.entry ? m.entry->name.c_str() : "?",
+                m.entry ? volume::toString(m.entry->family) : "?", m.match.distance);
+    if (m.fidelity)
+      std::printf(" %12s %12s %12s", percent(m.fidelity->maxMomentError).c_str(),
+                  percent(m.fidelity->meanDeviation).c_str(), percent(m.fidelity->maxDeviation).c_str());
+    std::printf("\n");
+  }
+  if (r.physics) {
+    const core::AdaptedPhysics& p = *r.physics;
+    const Eigen::SelfAdjointEigenSolver<core::Mat3> principal(p.massProperties.inertia,
+                                                              Eigen::EigenvaluesOnly);
+    std::printf("  physics (%s: ρ %.6g kg/m³, E %.6g Pa, ν %.3g)\n", p.material.name.c_str(),
+                p.material.density, p.material.youngsModulus, p.material.poissonRatio);
+    std::printf("    mass %.6g kg, principal moments %s kg m²\n", p.massProperties.mass,
+                toText(principal.eigenvalues()).c_str());
+    std::printf("    tet mesh %zu nodes, %zu tets; collision %zu shapes (coverage %.2f, overshoot %.2f)\n",
+                p.tetMesh.nodeCount(), p.tetMesh.tetCount(), p.collision.shapes.size(), p.collision.coverage,
+                p.collision.overshoot);
+    const Eigen::VectorXd hz = p.frequenciesHz();
+    std::printf("    frequencies (Hz):");
+    for (Eigen::Index i = 0; i < std::min<Eigen::Index>(hz.size(), 8); ++i)
+      std::printf(" %.5g", hz[i]);
+    std::printf(hz.size() > 8 ? " … (%ld modes)\n" : "\n", static_cast<long>(hz.size()));
+    if (!r.link.locations.empty())
+      std::printf("    linked %zu vertices, %zu outside the tets (max %.3g m)\n", r.link.locations.size(),
+                  r.link.outsideCount, r.link.maxOutsideDistance);
+    for (const std::string& w : p.warnings)
+      std::printf("    warning: %s\n", w.c_str());
+  }
+  if (timing) {
+    const io::QueryTimes& t = r.times;
+    std::printf(
+        "  timing (µs): mass properties %.1f, describe %.1f, search %.1f, fetch %.1f, adapt %.1f, link %.1f, "
+        "fidelity %.1f, total %.1f\n",
+        t.massProperties, t.describe, t.search, t.fetch, t.adapt, t.link, t.fidelity, t.total);
+  }
+}
+
+Status exportObj(const std::filesystem::path& dir, const std::string& stem, const io::QueryResult& r) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Error{ErrorCode::kIo, dir.string() + ": " + ec.message()};
+  const core::AdaptedPhysics& p = *r.physics;
+  const std::vector<std::pair<std::string, core::TriangleMesh>> volume{
+      {"volume", core::boundarySurface(p.tetMesh)}};
+  if (Status st = io::saveObjParts(volume, dir / (stem + ".volume.obj")); !st) return st;
+  std::vector<std::pair<std::string, core::TriangleMesh>> parts;
+  const std::vector<core::TriangleMesh> shapes = io::tessellate(p.collision);
+  for (std::size_t i = 0; i < shapes.size(); ++i)
+    parts.emplace_back(std::string(core::toString(p.collision.shapes[i].type)) + "_" + std::to_string(i),
+                       shapes[i]);
+  return io::saveObjParts(parts, dir / (stem + ".collision.obj"));
+}
+
+Status renderPng(const std::filesystem::path& path, const core::TriangleMesh& query,
+                 const io::QueryResult& r) {
+  const core::TriangleMesh match = core::boundarySurface(r.physics->tetMesh);
+  const std::vector<io::Panel> panels{{{&query}, {{{90, 140, 200}}}}, {{&match}, {{{230, 150, 60}}}}};
+  // Seen in the query's principal frame, from a three-quarter view: every query is shown the same way.
+  const core::Mat3 axes = r.normalization.principalAxes;
+  const core::Vec3 back = (axes * core::Vec3(0.5, 0.7, 1.0)).normalized();
+  const core::Vec3 right = (axes.col(2).cross(back)).normalized();
+  const core::Vec3 up = back.cross(right);
+  core::Mat3 view;
+  view.row(0) = right.transpose();
+  view.row(1) = up.transpose();
+  view.row(2) = back.transpose();
+  return io::savePng(io::renderPanels(panels, view), path);
+}
+
+std::filesystem::path pngPath(const std::string& png, std::size_t index, std::size_t count) {
+  const std::filesystem::path base(png);
+  if (count == 1) return base;
+  return base.parent_path() /
+         (base.stem().string() + "-" + std::to_string(index + 1) + base.extension().string());
+}
+
+int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
+  io::QueryOptions options;
+  options.descriptor = *core::parseDescriptorKind(o.descriptor);
+  options.search.k = o.k;
+  options.search.method = o.method == "brute-force" ? core::SearchMethod::kBruteForce
+                          : o.method == "buckets"   ? core::SearchMethod::kBuckets
+                                                    : core::SearchMethod::kPruned;
+  options.fidelity = !o.noFidelity;
+  const bool custom = app.count("--density") + app.count("--youngs") + app.count("--poisson") > 0;
+  if (custom) {
+    if (app.count("--material")) {
+      printError("--material and --density/--youngs/--poisson exclude each other");
+      return kExitUsage;
+    }
+    if (!app.count("--density") || !app.count("--youngs")) {
+      printError("a custom material needs --density and --youngs (--poisson defaults to 0.3)");
+      return kExitUsage;
+    }
+    options.material = {"custom", o.density, o.youngs, app.count("--poisson") ? o.poisson : 0.3};
+    if (Status st = core::validateMaterial(options.material); !st) {
+      printError(st.error().message);
+      return kExitUsage;
+    }
+  } else {
+    auto m = core::materialPreset(o.material);
+    if (!m) {
+      printError(m.error().message);
+      return kExitUsage;
+    }
+    options.material = *m;
+  }
+
+  auto db = io::Database::open(o.database);
+  if (!db) {
+    printError(db.error().message);
+    return kExitInputError;
+  }
+  nlohmann::json queries = nlohmann::json::array();
+  int status = kExitOk;
+  for (std::size_t i = 0; i < o.meshes.size(); ++i) {
+    const std::string& file = o.meshes[i];
+    auto loaded = io::loadMesh(file);
+    if (!loaded) {
+      printError(loaded.error().message);
+      status = kExitInputError;
+      continue;
+    }
+    auto result = db->query(loaded->mesh, options);
+    if (!result) {
+      printError(file + ": " + result.error().message);
+      status = kExitInputError;
+      continue;
+    }
+    if (!o.exportDir.empty())
+      if (Status st = exportObj(o.exportDir, std::filesystem::path(file).stem().string(), *result); !st) {
+        printError(st.error().message);
+        return kExitInputError;
+      }
+    if (!o.png.empty())
+      if (Status st = renderPng(pngPath(o.png, i, o.meshes.size()), loaded->mesh, *result); !st) {
+        printError(st.error().message);
+        return kExitInputError;
+      }
+    if (o.json) {
+      nlohmann::json q = {{"file", file},
+                          {"triangles", loaded->mesh.triangleCount()},
+                          {"volume", result->massProperties.volume},
+                          {"size", std::cbrt(result->massProperties.volume)},
+                          {"descriptor", o.descriptor},
+                          {"matches", nlohmann::json::array()},
+                          {"timing_us", timingJson(result->times)}};
+      for (const io::MatchReport& m : result->matches)
+        q["matches"].push_back(matchJson(m));
+      if (!result->matches.empty() && result->matches.front().fidelity)
+        q["fidelity"] = matchJson(result->matches.front())["fidelity"];
+      if (result->physics) q["physics"] = physicsJson(*result->physics);
+      q["link"] = {{"vertices", result->link.locations.size()},
+                   {"outside", result->link.outsideCount},
+                   {"max_outside_distance", result->link.maxOutsideDistance}};
+      queries.push_back(std::move(q));
+    } else {
+      printText(file, loaded->mesh, *result, o.timing);
+    }
+  }
+  if (o.json)
+    std::printf("%s\n", nlohmann::json{{"database", o.database}, {"queries", queries}}.dump(2).c_str());
+  return status;
+}
+
+}  // namespace
+
+Command addQueryCommand(CLI::App& parent) {
+  auto o = std::make_shared<QueryCommandOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "query",
+      "Find the database entries most similar to each mesh and give the mesh the best one's physical data\n"
+      "(paper Algorithm 1): the entry's tet mesh, modes, collision compound and mass properties carried to\n"
+      "the mesh's frame and size and scaled to a material; the mesh's vertices linked to the tets; and a\n"
+      "fidelity report per match (principal moments and surface deviation against the mesh, relative).\n"
+      "Meshes must be closed and consistently oriented. Exit status 1 if any mesh failed.");
+  app->add_option("DB", o->database, "Database file (shapedb build)")->required();
+  app->add_option("MESH", o->meshes, "Query surface meshes (.obj, .ply, .off, .stl)")->required();
+  app->add_option("-k,--k", o->k, "Matches to report, best first")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  app->add_option("--descriptor", o->descriptor, "Descriptor to match by")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"moment", "voxel", "centroid-voxel"}));
+  app->add_option("--method", o->method,
+                  "Search: pruned (exact, fast), brute-force (the oracle), buckets (the paper's heuristic)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"pruned", "brute-force", "buckets"}));
+  app->add_option("--material", o->material,
+                  "Material preset: steel, aluminium, glass, wood, rubber, concrete")
+      ->capture_default_str();
+  app->add_option("--density", o->density, "Custom material: density, kg/m³");
+  app->add_option("--youngs", o->youngs, "Custom material: Young's modulus, Pa");
+  app->add_option("--poisson", o->poisson, "Custom material: Poisson ratio (default 0.3)");
+  app->add_flag(
+      "--json", o->json,
+      "Print one JSON object: {database, queries: [{file, matches: [{entry_id, name, family, distance,\n"
+      "fidelity}], fidelity, physics: {mass, inertia, frequencies_hz, ...}, link, timing_us}]}");
+  app->add_option("--export-obj", o->exportDir,
+                  "Write <mesh>.volume.obj (the adapted tets' surface) and <mesh>.collision.obj into DIR");
+  app->add_option("--png", o->png, "Draw each query beside its match (several meshes: FILE-1.png, ...)");
+  app->add_flag("--timing", o->timing, "Print the time of each stage (text output; JSON always has it)");
+  app->add_flag("--no-fidelity", o->noFidelity, "Skip the fidelity report (it fetches every match's tets)");
+  return {app, [o, app] { return runQuery(*o, *app); }};
+}
+
+}  // namespace shapedb::cli
