@@ -1,0 +1,137 @@
+// shapedb query as a user runs it: the real executable on a real database file and real mesh files.
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/mesh_io.h>
+
+#include "support/subprocess.h"
+#include "support/test_support.h"
+
+namespace shapedb::cli {
+namespace {
+
+std::string readPrefix(const std::filesystem::path& path, std::size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  std::string s(n, '\0');
+  in.read(s.data(), static_cast<std::streamsize>(n));
+  return s.substr(0, static_cast<std::size_t>(in.gcount()));
+}
+
+TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
+  test::ScratchDir dir("query-cli");
+  const auto db = dir / "small.db";
+  test::ProcessResult built = test::runProcess(
+      SHAPEDB_CLI,
+      {"build", db.string(), "--entries", "6", "--families", "box,cylinder", "--modes", "4", "--quiet"});
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+
+  // A box 3 × 2 × 1 m... turned, moved and scaled by 0.1: a 30 × 20 × 10 cm box, far from the origin.
+  std::mt19937_64 rng(1);
+  core::Mat4 pose = test::randomSimilarity(rng, 5.0, 1.0, 1.0);
+  const auto box = dir / "box.ply";
+  ASSERT_TRUE(io::saveMesh(core::transformed(core::makeBox({0.3, 0.2, 0.1}), pose), box).ok());
+  const auto rod = dir / "rod.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeCylinder(0.02, 0.5, 32), rod).ok());
+
+  const auto png = dir / "side.png";
+  const auto objs = dir / "out";
+  test::ProcessResult q = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), box.string(), rod.string(), "--k", "2", "--material", "aluminium",
+                    "--json", "--png", png.string(), "--export-obj", objs.string()});
+  ASSERT_EQ(q.exitCode, 0) << q.err;
+  const nlohmann::json j = nlohmann::json::parse(q.out);
+  ASSERT_EQ(j["queries"].size(), 2u);
+  const nlohmann::json& b = j["queries"][0];
+  EXPECT_EQ(b["file"], box.string());
+  ASSERT_EQ(b["matches"].size(), 2u);
+  EXPECT_EQ(b["matches"][0]["family"], "box");
+  EXPECT_LE(b["matches"][0]["distance"].get<double>(), b["matches"][1]["distance"].get<double>());
+  EXPECT_TRUE(b["matches"][0]["entry_id"].is_number_unsigned());
+  const nlohmann::json& p = b["physics"];
+  EXPECT_EQ(p["material"]["name"], "aluminium");
+  EXPECT_NEAR(p["mass"].get<double>(), 2700.0 * 0.3 * 0.2 * 0.1, 1e-6 * 16.2);
+  EXPECT_EQ(p["frequencies_hz"].size(), 4u);
+  EXPECT_GT(p["frequencies_hz"][0].get<double>(), 100.0);  // an aluminium box of 30 cm rings in kHz
+  EXPECT_EQ(p["inertia"].size(), 3u);
+  EXPECT_GT(p["collision"]["shapes"].size(), 0u);
+  // Three box entries only, so the match is rough; the query's own moments are exact: for a 3:2:1 box of
+  // unit volume (sides 3s, 2s, s with 6s³ = 1), (5, 10, 13) s² / 12.
+  const double s2 = std::pow(6.0, -2.0 / 3.0);
+  const std::array<double, 3> expected{5.0 * s2 / 12.0, 10.0 * s2 / 12.0, 13.0 * s2 / 12.0};
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(b["fidelity"]["query_moments"][i].get<double>(), expected[i],
+                1e-6 * expected[i]);  // float file
+  EXPECT_GE(b["fidelity"]["max_moment_error"].get<double>(), 0.0);
+  EXPECT_GE(b["fidelity"]["mean_deviation"].get<double>(), 0.0);
+  for (const char* stage : {"describe", "search", "fetch", "adapt", "link", "total"})
+    EXPECT_GE(b["timing_us"][stage].get<double>(), 0.0) << stage;
+  EXPECT_EQ(j["queries"][1]["matches"][0]["family"], "cylinder");
+
+  // Files beside the queries: two PNGs (one per mesh), and OBJs of the adapted volume and compound.
+  for (const char* name : {"side-1.png", "side-2.png"})
+    EXPECT_EQ(readPrefix(dir / name, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << name;
+  for (const char* name : {"box.volume.obj", "box.collision.obj", "rod.volume.obj", "rod.collision.obj"})
+    EXPECT_GT(std::filesystem::file_size(objs / name), 100u) << name;
+  auto volume = io::loadMesh(objs / "box.volume.obj");
+  ASSERT_TRUE(volume.ok()) << volume.error().message;
+  EXPECT_TRUE(volume->topology.isClosed());
+
+  // Text output names the match and the stages with --timing.
+  test::ProcessResult text = test::runProcess(SHAPEDB_CLI, {"query", db.string(), box.string(), "--timing"});
+  ASSERT_EQ(text.exitCode, 0) << text.err;
+  EXPECT_NE(text.out.find("box-0"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("timing (µs)"), std::string::npos) << text.out;
+}
+
+TEST(QueryCli, BadInputsAreClearErrors) {
+  test::ScratchDir dir("query-cli-bad");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box",
+                                           "--modes", "2", "--quiet"})
+                .exitCode,
+            0);
+  const auto good = dir / "good.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), good).ok());
+  // An open surface: a tetrahedron without its fourth face.
+  const auto openPath = dir / "open.obj";
+  std::ofstream(openPath) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n";
+
+  test::ProcessResult missing =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), (dir / "none.obj").string()});
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("none.obj"), std::string::npos) << missing.err;
+
+  test::ProcessResult openQuery =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), openPath.string(), good.string()});
+  EXPECT_EQ(openQuery.exitCode, 1) << "one mesh failed";
+  EXPECT_NE(openQuery.err.find("open.obj"), std::string::npos) << openQuery.err;
+  EXPECT_NE(openQuery.out.find("good.obj"), std::string::npos) << "the good mesh is still answered";
+
+  test::ProcessResult material =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), good.string(), "--material", "cheese"});
+  EXPECT_EQ(material.exitCode, 2);
+  EXPECT_NE(material.err.find("unknown material 'cheese'"), std::string::npos) << material.err;
+
+  test::ProcessResult both = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), good.string(), "--material", "steel", "--density", "1000"});
+  EXPECT_EQ(both.exitCode, 2);
+  test::ProcessResult custom = test::runProcess(
+      SHAPEDB_CLI,
+      {"query", db.string(), good.string(), "--density", "1000", "--youngs", "1e9", "--poisson", "0.45"});
+  EXPECT_EQ(custom.exitCode, 0) << custom.err;
+  EXPECT_NE(custom.out.find("warning: material Poisson ratio"), std::string::npos) << custom.out;
+
+  test::ProcessResult notDb = test::runProcess(SHAPEDB_CLI, {"query", good.string(), good.string()});
+  EXPECT_EQ(notDb.exitCode, 1);
+  EXPECT_NE(notDb.err.find("good.obj"), std::string::npos) << notDb.err;
+}
+
+}  // namespace
+}  // namespace shapedb::cli
