@@ -141,8 +141,8 @@ SurfaceLink linkSurface(const TetLocator& locator, const Placement& placement,
   SurfaceLink link;
   link.locations.resize(vertices.size());
   const auto one = [&](std::size_t i) { link.locations[i] = locator.locate(placement.toEntry(vertices[i])); };
-  if (vertices.size() >= 4096) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 1024), [&](const auto& r) {
+  if (vertices.size() >= 1024) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256), [&](const auto& r) {
       for (std::size_t i = r.begin(); i < r.end(); ++i)
         one(i);
     });

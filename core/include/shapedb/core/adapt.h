@@ -88,7 +88,7 @@ struct SurfaceLink {
 /// Links `vertices` (the query's, in its frame) to the entry's tets through `locator`, built on the
 /// entry's canonical tet mesh: the vertices are carried to the entry's frame by `placement`, so one
 /// locator serves every query that matches the entry. Distances are reported in the query's units.
-/// Parallel (TBB) above a few thousand vertices.
+/// Parallel (TBB) from 1,024 vertices.
 SurfaceLink linkSurface(const TetLocator& locator, const Placement& placement,
                         std::span<const Vec3> vertices);
 
