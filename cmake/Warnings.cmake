@@ -14,7 +14,15 @@ function(shapedb_add_module name)
     $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
   target_link_libraries(shapedb_${name} PUBLIC ${ARG_PUBLIC_DEPENDS} PRIVATE ${ARG_PRIVATE_DEPENDS}
     $<BUILD_INTERFACE:shapedb_warnings>)
-  set_target_properties(shapedb_${name} PROPERTIES OUTPUT_NAME shapedb_${name} POSITION_INDEPENDENT_CODE ON)
+  set_target_properties(shapedb_${name} PROPERTIES OUTPUT_NAME shapedb_${name} POSITION_INDEPENDENT_CODE ON
+    EXPORT_NAME ${name})
+  if(SHAPEDB_NATIVE_ARCH)
+    # Eigen's fixed-size types change layout and alignment with the vector ISA: code that includes our
+    # headers must be compiled for the same one, or it reads our structs wrongly (it crashed).
+    target_compile_options(shapedb_${name} INTERFACE -march=native)
+  endif()
+  install(TARGETS shapedb_${name} EXPORT shapedbTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endfunction()
 
 # GCC 12's AVX-512 intrinsics trip its own -Wmaybe-uninitialized wherever Eigen's packet code is inlined
