@@ -33,6 +33,7 @@ struct QueryCommandOptions {
   bool json = false;
   bool timing = false;
   bool noFidelity = false;
+  bool table = false;
   std::string exportDir;
   std::string png;
 };
@@ -189,6 +190,33 @@ std::filesystem::path pngPath(const std::string& png, std::size_t index, std::si
          (base.stem().string() + "-" + std::to_string(index + 1) + base.extension().string());
 }
 
+/// One line per query: the best match, its fidelity, and the adapted physics in brief.
+void printTableHeader() {
+  std::printf("%-24s %-16s %9s %9s %9s %11s %10s %10s %10s\n", "mesh", "best match", "distance", "dev.mean",
+              "mom.err", "mass (kg)", "f1 (Hz)", "f2 (Hz)", "f3 (Hz)");
+}
+
+void printTableRow(const std::string& file, const io::QueryResult& r) {
+  const io::MatchReport& m = r.matches.front();
+  std::printf("%-24s %-16s %9.4f", std::filesystem::path(file).filename().string().c_str(),
+              m.entry ? m.entry->name.c_str() : "?", m.match.distance);
+  if (m.fidelity)
+    std::printf(" %9s %9s", percent(m.fidelity->meanDeviation).c_str(),
+                percent(m.fidelity->maxMomentError).c_str());
+  else
+    std::printf(" %9s %9s", "-", "-");
+  if (r.physics) {
+    const Eigen::VectorXd hz = r.physics->frequenciesHz();
+    std::printf(" %11.4g", r.physics->massProperties.mass);
+    for (Eigen::Index i = 0; i < 3; ++i)
+      if (i < hz.size())
+        std::printf(" %10.1f", hz[i]);
+      else
+        std::printf(" %10s", "-");
+  }
+  std::printf("\n");
+}
+
 int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   io::QueryOptions options;
   options.descriptor = *core::parseDescriptorKind(o.descriptor);
@@ -228,6 +256,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   }
   nlohmann::json queries = nlohmann::json::array();
   int status = kExitOk;
+  if (o.table && !o.json) printTableHeader();
   for (std::size_t i = 0; i < o.meshes.size(); ++i) {
     const std::string& file = o.meshes[i];
     auto loaded = io::loadMesh(file);
@@ -269,6 +298,8 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
                    {"outside", result->link.outsideCount},
                    {"max_outside_distance", result->link.maxOutsideDistance}};
       queries.push_back(std::move(q));
+    } else if (o.table) {
+      printTableRow(file, *result);
     } else {
       printText(file, loaded->mesh, *result, o.timing);
     }
@@ -315,6 +346,8 @@ Command addQueryCommand(CLI::App& parent) {
                   "Write <mesh>.volume.obj (the adapted tets' surface) and <mesh>.collision.obj into DIR");
   app->add_option("--png", o->png, "Draw each query beside its match (several meshes: FILE-1.png, ...)");
   app->add_flag("--timing", o->timing, "Print the time of each stage (text output; JSON always has it)");
+  app->add_flag("--table", o->table,
+                "One line per mesh: best match, fidelity, mass, first three frequencies");
   app->add_flag("--no-fidelity", o->noFidelity, "Skip the fidelity report (it fetches every match's tets)");
   return {app, [o, app] { return runQuery(*o, *app); }};
 }

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Sets everything up (Debian packages, release build), builds the demo database on the spot if it is not
-# there yet (350 entries of all seven families, about 30 s on 2 cores), and runs the main job on it and on
-# the bundled sample. Usage: scripts/demo.sh [DB]   (default build/demo.db)
+# there yet (350 entries of all seven families, about 30 s on 2 cores), and runs the main job on it: the
+# bundled sample meshes (data/samples, made by scripts/make_samples.py) queried against it, one table of
+# matches and physical data, then one query in full with its timing and a picture of query and match.
+# Usage: scripts/demo.sh [DB]   (default build/demo.db)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh release >/dev/null
@@ -15,6 +17,8 @@ fi
 echo
 "$shapedb" info "$db"
 echo
-"$shapedb" inspect data/samples/pebble.obj
+"$shapedb" query "$db" data/samples/*.obj --table --material steel
 echo
-"$shapedb" describe data/samples/pebble.obj
+"$shapedb" query "$db" data/samples/egg.obj --k 3 --material glass --timing --png build/demo-egg.png \
+  --export-obj build/demo-export
+echo "(build/demo-egg.png: the query beside its match; build/demo-export: the adapted tets and collision compound)"
