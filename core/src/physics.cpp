@@ -72,29 +72,36 @@ MassProperties computeTetMassProperties(const TetMesh& mesh, double density) {
   return result;
 }
 
-TriangleMesh boundarySurface(const TetMesh& mesh) {
+std::vector<BoundaryFace> boundaryFaces(const TetMesh& mesh) {
   // A face seen by one tet only is on the boundary. Faces of a positively oriented tet (a, b, c, d),
   // wound outward: (a, c, b), (a, b, d), (b, c, d), (a, d, c).
-  std::map<std::array<std::uint32_t, 3>, std::pair<std::array<std::uint32_t, 3>, int>> faces;
-  for (const auto& [a, b, c, d] : mesh.tets) {
+  std::map<std::array<std::uint32_t, 3>, std::pair<BoundaryFace, int>> faces;
+  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
+    const auto& [a, b, c, d] = mesh.tets[t];
     for (const std::array<std::uint32_t, 3>& f :
          {std::array{a, c, b}, std::array{a, b, d}, std::array{b, c, d}, std::array{a, d, c}}) {
       std::array<std::uint32_t, 3> key = f;
       std::sort(key.begin(), key.end());
-      auto [it, inserted] = faces.try_emplace(key, f, 0);
+      auto [it, inserted] = faces.try_emplace(key, BoundaryFace{f, t}, 0);
       ++it->second.second;
     }
   }
+  std::vector<BoundaryFace> out;
+  for (const auto& [key, face] : faces)
+    if (face.second == 1) out.push_back(face.first);
+  return out;
+}
+
+TriangleMesh boundarySurface(const TetMesh& mesh) {
   TriangleMesh surface;
   std::vector<std::uint32_t> remap(mesh.nodes.size(), UINT32_MAX);
-  for (const auto& [key, face] : faces) {
-    if (face.second != 1) continue;
+  for (const BoundaryFace& face : boundaryFaces(mesh)) {
     TriangleMesh::Triangle triangle;
     for (int i = 0; i < 3; ++i) {
-      std::uint32_t& r = remap[face.first[static_cast<std::size_t>(i)]];
+      std::uint32_t& r = remap[face.nodes[static_cast<std::size_t>(i)]];
       if (r == UINT32_MAX) {
         r = static_cast<std::uint32_t>(surface.vertices.size());
-        surface.vertices.push_back(mesh.nodes[face.first[static_cast<std::size_t>(i)]]);
+        surface.vertices.push_back(mesh.nodes[face.nodes[static_cast<std::size_t>(i)]]);
       }
       triangle[static_cast<std::size_t>(i)] = r;
     }

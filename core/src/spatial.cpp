@@ -1,7 +1,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <numeric>
 
 #include <shapedb/core/spatial.h>
@@ -190,31 +189,11 @@ TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tet
               static_cast<std::uint32_t>(t);
   }
 
-  // Boundary faces: those of one tet only, wound outward (a tet's face opposite vertex i, ordered so
-  // that its normal points away from vertex i).
-  static constexpr std::array<std::array<int, 3>, 4> kFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
-  std::map<std::array<std::uint32_t, 3>, std::pair<std::uint32_t, int>> faces;
-  std::vector<std::array<std::uint32_t, 3>> order;
-  for (std::size_t t = 0; t < n; ++t)
-    for (int f = 0; f < 4; ++f) {
-      std::array<std::uint32_t, 3> key{mTets[t][kFaces[f][0]], mTets[t][kFaces[f][1]],
-                                       mTets[t][kFaces[f][2]]};
-      std::sort(key.begin(), key.end());
-      if (const auto it = faces.find(key); it != faces.end()) {
-        faces.erase(it);
-      } else {
-        faces.emplace(key, std::pair{static_cast<std::uint32_t>(t), f});
-        order.push_back(key);
-      }
-    }
   TriangleMesh boundary;
   boundary.vertices = mNodes;
-  for (const auto& key : order) {
-    const auto it = faces.find(key);
-    if (it == faces.end()) continue;
-    const auto [t, f] = it->second;
-    boundary.triangles.push_back({mTets[t][kFaces[f][0]], mTets[t][kFaces[f][1]], mTets[t][kFaces[f][2]]});
-    mOwner.push_back(t);
+  for (const BoundaryFace& face : boundaryFaces(mesh)) {
+    boundary.triangles.push_back(face.nodes);
+    mOwner.push_back(face.tet);
   }
   mBoundary = ClosestPointTree(boundary);
 }

@@ -38,6 +38,13 @@ Status validateTetMesh(const TetMesh& mesh);
 /// frame. `area` is left 0: a tet mesh knows no surface. Preconditions: validateTetMesh passed.
 MassProperties computeTetMassProperties(const TetMesh& mesh, double density = 1.0);
 
+/// A face of a tet mesh that belongs to one tet only: its nodes (mesh indices), wound outward, and that tet.
+struct BoundaryFace {
+  std::array<std::uint32_t, 3> nodes;
+  std::uint32_t tet = 0;
+};
+/// Every boundary face of a tet mesh, ordered by sorted node triple (deterministic).
+std::vector<BoundaryFace> boundaryFaces(const TetMesh& mesh);
 /// The boundary of a tet mesh: every face that belongs to one tet only, wound outward, over the nodes
 /// it uses (renumbered). For a conforming mesh of a solid, a closed surface.
 TriangleMesh boundarySurface(const TetMesh& mesh);
