@@ -60,6 +60,24 @@ void BM_AnalyzeTopology(benchmark::State& state) {
 }
 BENCHMARK(BM_AnalyzeTopology)->Arg(5000)->Arg(100000)->Unit(benchmark::kMicrosecond);
 
+// Its oracle: one global sort of the half-edges.
+void BM_AnalyzeTopologyBySorting(benchmark::State& state) {
+  const core::TriangleMesh mesh = meshOfTriangles(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(core::analyzeTopologyBySorting(mesh));
+  setTriangleCounters(state, mesh);
+}
+BENCHMARK(BM_AnalyzeTopologyBySorting)->Arg(5000)->Arg(100000)->Unit(benchmark::kMicrosecond);
+
+// The per-face checks of validateMesh (finite, in range, not degenerate).
+void BM_ValidateMesh(benchmark::State& state) {
+  const core::TriangleMesh mesh = meshOfTriangles(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(core::validateMesh(mesh));
+  setTriangleCounters(state, mesh);
+}
+BENCHMARK(BM_ValidateMesh)->Arg(5000)->Arg(100000)->Unit(benchmark::kMicrosecond);
+
 // Loading a binary PLY: parse, validate, topology.
 void BM_LoadBinaryPly(benchmark::State& state) {
   const core::TriangleMesh mesh = meshOfTriangles(state.range(0));

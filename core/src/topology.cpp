@@ -55,6 +55,74 @@ std::string plural(std::size_t n, const std::string& noun, const std::string& no
 TopologyReport analyzeTopology(const TriangleMesh& mesh) {
   TopologyReport report;
   report.triangleCount = mesh.triangles.size();
+  const std::size_t vertexCount = mesh.vertices.size();
+
+  // Bucket the half-edges by their lower vertex (a counting sort, O(F + V)): bucket v holds, for each
+  // half-edge {v, w} with v < w, the entry 2w + (direction v → w). An edge's half-edges then share a
+  // bucket and, once the bucket is sorted, sit next to each other. Buckets are small (about three
+  // edges per vertex on a triangle mesh), so sorting them costs little whatever the vertex order.
+  std::vector<std::size_t> bucketStart(vertexCount + 1, 0);
+  std::vector<char> referenced(vertexCount, 0);
+  for (const auto& t : mesh.triangles) {
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+      referenced[a] = 1;
+      if (a != b) ++bucketStart[std::min(a, b) + 1];
+    }
+  }
+  for (std::size_t v = 0; v < vertexCount; ++v)
+    bucketStart[v + 1] += bucketStart[v];
+  std::vector<std::uint64_t> entries(bucketStart[vertexCount]);
+  {
+    std::vector<std::size_t> cursor(bucketStart.begin(), bucketStart.end() - 1);
+    for (const auto& t : mesh.triangles) {
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+        if (a == b) continue;
+        entries[cursor[std::min(a, b)]++] = (std::uint64_t{std::max(a, b)} << 1) | (a < b ? 1u : 0u);
+      }
+    }
+  }
+
+  // Classify each edge by how many half-edges share it, and in which directions.
+  DisjointSets sets(vertexCount);
+  for (std::size_t v = 0; v < vertexCount; ++v) {
+    const auto first = entries.begin() + static_cast<std::ptrdiff_t>(bucketStart[v]);
+    const auto last = entries.begin() + static_cast<std::ptrdiff_t>(bucketStart[v + 1]);
+    std::sort(first, last);
+    for (auto begin = first; begin != last;) {
+      const std::uint64_t upper = *begin >> 1;
+      auto end = begin + 1;
+      while (end != last && (*end >> 1) == upper)
+        ++end;
+      const auto count = end - begin;
+      ++report.edgeCount;
+      if (count == 1) ++report.boundaryEdges;
+      if (count > 2) ++report.nonManifoldEdges;
+      if (count == 2 && begin[0] == begin[1]) ++report.inconsistentEdges;
+      sets.unite(static_cast<std::uint32_t>(v), static_cast<std::uint32_t>(upper));
+      begin = end;
+    }
+  }
+
+  // Components are the distinct roots among referenced vertices.
+  std::vector<char> isRoot(vertexCount, 0);
+  for (std::uint32_t v = 0; v < vertexCount; ++v) {
+    if (!referenced[v]) {
+      ++report.unreferencedVertices;
+      continue;
+    }
+    ++report.vertexCount;
+    const std::uint32_t root = sets.find(v);
+    if (!isRoot[root]) ++report.components;
+    isRoot[root] = 1;
+  }
+  return report;
+}
+
+TopologyReport analyzeTopologyBySorting(const TriangleMesh& mesh) {
+  TopologyReport report;
+  report.triangleCount = mesh.triangles.size();
 
   // Each half-edge as (undirected key, direction); sorting groups the half-edges of an edge together.
   struct HalfEdge {

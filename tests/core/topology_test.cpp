@@ -1,3 +1,8 @@
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <shapedb/core/primitives.h>
@@ -64,6 +69,59 @@ TEST(Topology, CountsComponentsAndUnreferencedVertices) {
   EXPECT_EQ(t.components, 2u);
   EXPECT_EQ(t.eulerCharacteristic(), 4);
   EXPECT_EQ(t.unreferencedVertices, 1u);
+}
+
+void expectSameReport(const TopologyReport& a, const TopologyReport& b) {
+  EXPECT_EQ(a.vertexCount, b.vertexCount);
+  EXPECT_EQ(a.unreferencedVertices, b.unreferencedVertices);
+  EXPECT_EQ(a.triangleCount, b.triangleCount);
+  EXPECT_EQ(a.edgeCount, b.edgeCount);
+  EXPECT_EQ(a.boundaryEdges, b.boundaryEdges);
+  EXPECT_EQ(a.nonManifoldEdges, b.nonManifoldEdges);
+  EXPECT_EQ(a.inconsistentEdges, b.inconsistentEdges);
+  EXPECT_EQ(a.components, b.components);
+}
+
+// The bucketed analysis against the global sort, on random soups (every defect at once: repeated
+// indices, fins, flipped and doubled faces) and on damaged closed meshes with shuffled vertex ids.
+TEST(Topology, BucketedAnalysisAgreesWithTheGlobalSortOnRandomMeshes) {
+  std::mt19937 rng(20261122);
+  for (int trial = 0; trial < 300; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    TriangleMesh mesh;
+    if (trial % 2 == 0) {
+      const int vertexCount = std::uniform_int_distribution<int>(3, 40)(rng);
+      mesh.vertices.assign(static_cast<std::size_t>(vertexCount), Vec3::Zero());
+      std::uniform_int_distribution<std::uint32_t> index(0, static_cast<std::uint32_t>(vertexCount - 1));
+      const int faceCount = std::uniform_int_distribution<int>(1, 200)(rng);
+      for (int f = 0; f < faceCount; ++f)
+        mesh.triangles.push_back({index(rng), index(rng), index(rng)});
+    } else {
+      mesh = makeIcosphere(1.0, 2);
+      std::vector<std::uint32_t> relabel(mesh.vertices.size());
+      std::iota(relabel.begin(), relabel.end(), 0u);
+      std::shuffle(relabel.begin(), relabel.end(), rng);
+      for (auto& t : mesh.triangles)
+        for (auto& v : t)
+          v = relabel[v];
+      std::uniform_int_distribution<std::size_t> face(0, mesh.triangles.size() - 1);
+      for (int damage = trial % 7; damage > 0; --damage) {
+        switch (damage % 3) {
+          case 0:
+            mesh.triangles.erase(mesh.triangles.begin() + static_cast<std::ptrdiff_t>(face(rng)));
+            break;
+          case 1:
+            mesh.triangles.push_back(mesh.triangles[face(rng)]);
+            break;
+          default: {
+            auto& flipped = mesh.triangles[face(rng)];
+            std::swap(flipped[0], flipped[1]);
+          }
+        }
+      }
+    }
+    expectSameReport(analyzeTopology(mesh), analyzeTopologyBySorting(mesh));
+  }
 }
 
 TEST(Validate, AcceptsAGoodMesh) {

@@ -29,8 +29,13 @@ struct TopologyReport {
 };
 
 /// Counts boundary, non-manifold and inconsistently oriented edges and connected components.
-/// Precondition: every index is in range (validateMesh). O(F log F); thread-safe (pure function).
+/// Precondition: every index is in range (validateMesh). O(F + V) for meshes whose vertices have
+/// bounded degree (half-edges bucketed by vertex); thread-safe (pure function).
 TopologyReport analyzeTopology(const TriangleMesh& mesh);
+
+/// The same report by the plain method, one global sort of all half-edges: O(F log F). The oracle
+/// that analyzeTopology is tested against.
+TopologyReport analyzeTopologyBySorting(const TriangleMesh& mesh);
 
 /// The error a mass-property computation should report for this topology, or Ok when the surface is
 /// closed and consistently oriented: "mesh is not closed (14 boundary edges)".
