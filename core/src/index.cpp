@@ -21,7 +21,12 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kProfileBins = 16;
 constexpr int kBlocksPerAxis = 4;  // the coarse 4³ block grid of the third bound
-constexpr int kQuantLevels = 32;
+// An odd number of levels, so that a centroid coordinate of exactly 0.5 (a wall that crosses its cell,
+// a face on the plane of symmetry) falls in the middle of a level rather than on the edge between two:
+// with 32, round-off of either sign split such coordinates between levels 15 and 16, and the same
+// shape described in a frame reversed along that axis quantized differently. 0 and 1 (a face on a
+// cell plane) fall inside levels 0 and 30.
+constexpr int kQuantLevels = 31;
 constexpr int kMaxSquaredCode = 3 * (kQuantLevels - 1) * (kQuantLevels - 1);
 constexpr std::size_t kLeafSize = 8;
 

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -151,12 +152,29 @@ TEST(Index, QuantizedDistanceStaysWithinACentroidStepOfTheExactOne) {
     ASSERT_EQ(matches.size(), entries.size());
     for (const Match& m : matches) {
       const double exact = centroidVoxelDistance(entries[q], entries[(m.entry - 1000) / 7]);
-      // Each quantized coordinate moves by ≤ 1/64 cell, so each centroid term by ≤ 2 · (√3/64) / √3.
-      EXPECT_NEAR(m.distance, exact, 1.0 / 32.0 + 1e-6);
+      // Each quantized coordinate moves by ≤ 1/62 cell, so each centroid term by ≤ 2 · (√3/62) / √3.
+      EXPECT_NEAR(m.distance, exact, 1.0 / 31.0 + 1e-6);
     }
     EXPECT_EQ(matches.front().entry, 1000 + 7 * q);
     EXPECT_LT(matches.front().distance, 1.0 / 64.0);
   }
+}
+
+// Centroid coordinates that shapes make exact (0.5 for a wall crossing its cell, 0 and 1 for a face on a
+// cell plane) must not sit on the edge between two levels, where round-off of either sign decides.
+TEST(Index, CentroidsAtTheMiddleAndEdgesOfACellQuantizeTheSameWhateverTheRoundOff) {
+  for (double exact : {0.0, 0.5, 1.0})
+    for (int axis = 0; axis < 3; ++axis) {
+      Vec3 below = Vec3::Constant(0.3), above = below;
+      below[axis] = std::clamp(exact - 1e-14, 0.0, 1.0);
+      above[axis] = std::clamp(exact + 1e-14, 0.0, 1.0);
+      EXPECT_EQ(quantizeCentroid(below), quantizeCentroid(above)) << exact << " on axis " << axis;
+      // Reversing the axis maps the coordinate to 1 − itself, and its level to the mirror level.
+      Vec3 mirrored = below;
+      mirrored[axis] = 1.0 - below[axis];
+      const int level = quantizeCentroid(below) >> (5 * axis) & 31;
+      EXPECT_EQ(quantizeCentroid(mirrored) >> (5 * axis) & 31, 30 - level) << exact << " on axis " << axis;
+    }
 }
 
 TEST(Index, TiesBreakByEntryId) {

@@ -57,11 +57,12 @@ struct SearchStats {
 ///
 /// Layout (voxel kinds): entries sorted by filled-cell count; per entry the occupancy bit-packed
 /// (⌈N³/64⌉ words), its filled-cell counts per slab and per block (CountProfile, the lower bounds),
-/// and for centroid-voxel the centroid of each filled cell quantized to 5 bits per axis (2 bytes).
+/// and for centroid-voxel the centroid of each filled cell quantized to 31 levels per axis (5 bits,
+/// 2 bytes a centroid; 0.5 is the middle of a level, so a centroid there is robust to round-off).
 /// Moment descriptors: a k-d tree over the three moments.
 ///
 /// Distances are those of core::descriptorDistance on the quantized centroids (each coordinate moves
-/// by at most 1/64 of a cell), for every search method alike. Ties break by entry id, so results do not
+/// by at most 1/62 of a cell), for every search method alike. Ties break by entry id, so results do not
 /// depend on the method's order of work or on the thread count.
 ///
 /// Immutable once built; search is thread-safe. Build it with IndexBuilder.
@@ -151,7 +152,7 @@ class IndexBuilder {
   std::vector<Vec3> mMoments;
 };
 
-/// A centroid in its cell's unit cube, quantized to 5 bits per axis (x in the low bits).
+/// A centroid in its cell's unit cube, quantized to 31 levels per axis, 5 bits each (x in the low bits).
 std::uint16_t quantizeCentroid(const Vec3& centroid);
 Vec3 dequantizeCentroid(std::uint16_t code);
 
