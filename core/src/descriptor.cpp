@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <string>
@@ -96,6 +97,56 @@ double descriptorDistance(const Descriptor& a, const Descriptor& b) {
       return centroidVoxelDistance(a, b);
   }
   return 0.0;
+}
+
+std::optional<Descriptor> reorientDescriptor(const Descriptor& d, const Mat3& rotation) {
+  // Target axis a takes source axis source[a], reversed when reversed[a].
+  std::array<int, 3> source{};
+  std::array<bool, 3> reversed{};
+  constexpr double kTolerance = 1e-12;
+  for (int a = 0; a < 3; ++a) {
+    int nonZero = 0;
+    for (int b = 0; b < 3; ++b) {
+      const double r = rotation(a, b);
+      if (std::abs(r) <= kTolerance) continue;
+      if (std::abs(std::abs(r) - 1.0) > kTolerance) return std::nullopt;
+      source[static_cast<std::size_t>(a)] = b;
+      reversed[static_cast<std::size_t>(a)] = r < 0.0;
+      ++nonZero;
+    }
+    if (nonZero != 1) return std::nullopt;
+  }
+  if (source[0] == source[1] || source[1] == source[2] || source[0] == source[2]) return std::nullopt;
+
+  Descriptor out = d;
+  out.orientation = rotation * d.orientation;
+  if (d.kind == DescriptorKind::kMoment) return out;
+  const int n = d.gridSize;
+  struct Cell {
+    std::uint32_t linear;
+    std::size_t from;
+    Vec3 centroid;
+  };
+  std::vector<Cell> moved(d.cells.size());
+  for (std::size_t i = 0; i < d.cells.size(); ++i) {
+    const std::array<int, 3> ijk = cellCoordinates(d.cells[i], n);
+    std::array<int, 3> to{};
+    Vec3 centroid;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto b = static_cast<std::size_t>(source[a]);
+      const double c = d.centroids.empty() ? 0.5 : d.centroids[i][static_cast<Eigen::Index>(b)];
+      to[a] = reversed[a] ? n - 1 - ijk[b] : ijk[b];
+      centroid[static_cast<Eigen::Index>(a)] = reversed[a] ? 1.0 - c : c;
+    }
+    moved[i] = {linearCell(to[0], to[1], to[2], n), i, centroid};
+  }
+  std::sort(moved.begin(), moved.end(), [](const Cell& l, const Cell& r) { return l.linear < r.linear; });
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    out.cells[i] = moved[i].linear;
+    if (!d.centroids.empty()) out.centroids[i] = moved[i].centroid;
+    if (!d.weights.empty()) out.weights[i] = d.weights[moved[i].from];
+  }
+  return out;
 }
 
 const char* toString(DescriptorKind kind) {

@@ -1,9 +1,12 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <random>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <shapedb/core/index.h>
@@ -59,6 +62,61 @@ TEST(Describe, BoxWithFacesOnCellPlanesFillsExactlyItsCells) {
     EXPECT_NEAR(area, 22.0 / (unit * unit), 1e-12);
     EXPECT_LT(moment.norm(), 1e-12);
   }
+}
+
+// The 24 proper rotations that permute and reverse axes.
+std::vector<core::Mat3> signedPermutations() {
+  std::vector<core::Mat3> out;
+  std::array<int, 3> axes{0, 1, 2};
+  do {
+    for (int signs = 0; signs < 8; ++signs) {
+      core::Mat3 r = core::Mat3::Zero();
+      for (int a = 0; a < 3; ++a)
+        r(a, axes[static_cast<std::size_t>(a)]) = (signs >> a & 1) ? -1.0 : 1.0;
+      if (r.determinant() > 0.0) out.push_back(r);
+    }
+  } while (std::next_permutation(axes.begin(), axes.end()));
+  return out;
+}
+
+// Reindexing the canonical grid (what describeCandidates does for such candidates) against describing
+// the surface again in the rotated frame: boxes with faces on cell planes, random shapes.
+TEST(Describe, ReorientedDescriptorEqualsDescribingInTheRotatedFrame) {
+  const std::vector<core::Mat3> rotations = signedPermutations();
+  ASSERT_EQ(rotations.size(), 24u);
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 12; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const TriangleMesh mesh = trial == 0   ? core::makeBox(Vec3(3.0, 2.0, 1.0))
+                              : trial == 1 ? test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 3)
+                                           : test::makeRandomShape(rng, 3);
+    const int gridSize = trial == 0 ? 6 : 10;
+    for (DescriptorKind kind : {DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
+      Describer describer(test::descriptorOptions(kind, Sampling::kArea, gridSize));
+      Result<test::DescribedMesh> described =
+          test::describeMesh(mesh, test::descriptorOptions(kind, Sampling::kArea, gridSize));
+      ASSERT_TRUE(described.ok());
+      const core::Normalization& normalization = described->normalization;
+      const Result<Descriptor> canonical = describer.describe(mesh, normalization);
+      ASSERT_TRUE(canonical.ok());
+      for (const core::Mat3& rotation : rotations) {
+        const Result<Descriptor> direct = describer.describe(mesh, normalization, rotation);
+        ASSERT_TRUE(direct.ok());
+        const std::optional<Descriptor> moved = core::reorientDescriptor(*canonical, rotation);
+        ASSERT_TRUE(moved.has_value());
+        ASSERT_EQ(moved->cells, direct->cells) << rotation;
+        EXPECT_EQ(moved->orientation, direct->orientation);
+        for (std::size_t c = 0; c < direct->cells.size(); ++c) {
+          EXPECT_LT((moved->centroids[c] - direct->centroids[c]).norm(), 1e-9);
+          EXPECT_NEAR(moved->weights[c], direct->weights[c], 1e-9 * direct->weights[c]);
+        }
+        EXPECT_LT(core::descriptorDistance(*moved, *direct), 1e-9);
+      }
+    }
+  }
+  // A turn that is not a quarter turn cannot be reindexed.
+  const core::Mat3 turn = Eigen::AngleAxisd(0.3, Vec3::UnitZ()).toRotationMatrix();
+  EXPECT_FALSE(core::reorientDescriptor(Descriptor{}, turn).has_value());
 }
 
 TEST(Describe, VertexSamplingBinsTheVerticesAsThePaperDoes) {

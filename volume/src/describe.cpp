@@ -363,6 +363,13 @@ Result<std::vector<core::Descriptor>> Describer::describeCandidates(
                                           : core::orientationCandidates(normalization, orientation);
   out.reserve(rotations.size());
   for (const Mat3& rotation : rotations) {
+    // With area sampling, a candidate that only permutes or reverses axes (the sign flips of a
+    // generic shape, the quarter turns of a square section) is the canonical grid reindexed.
+    if (!out.empty() && mOptions.sampling == Sampling::kArea)
+      if (std::optional<core::Descriptor> d = core::reorientDescriptor(out.front(), rotation)) {
+        out.push_back(std::move(*d));
+        continue;
+      }
     Result<core::Descriptor> d = describe(mesh, normalization, rotation);
     if (!d) return d.error();
     out.push_back(std::move(d).value());

@@ -102,6 +102,15 @@ double centroidVoxelDistance(const Descriptor& a, const Descriptor& b);
 /// The similarity of the descriptors' kind (a's kind; b must be of the same kind and grid size).
 double descriptorDistance(const Descriptor& a, const Descriptor& b);
 
+/// The descriptor of the same shape in the frame `rotation` · (d's frame), when `rotation` only
+/// permutes and reverses axes (every entry within 1e-12 of 0 or ±1), without describing the surface
+/// again: the grid is centred on the origin and its side is the largest extent, so such a rotation
+/// maps whole cells to cells and each centroid's coordinates to themselves or 1 − themselves.
+/// Equals Describer::describe in the rotated frame up to round-off for area sampling. (With vertex
+/// sampling a vertex lying on a cell plane belongs to the cell above it, which a reversal changes.)
+/// nullopt when `rotation` is not such a matrix. Moment descriptors come back unchanged.
+std::optional<Descriptor> reorientDescriptor(const Descriptor& d, const Mat3& rotation);
+
 /// "moment", "voxel", "centroid-voxel"; "area", "vertices".
 const char* toString(DescriptorKind kind);
 const char* toString(Sampling sampling);
