@@ -140,15 +140,17 @@ SurfaceLink linkSurface(const TetLocator& locator, const Placement& placement,
                         std::span<const Vec3> vertices) {
   SurfaceLink link;
   link.locations.resize(vertices.size());
-  const auto one = [&](std::size_t i) { link.locations[i] = locator.locate(placement.toEntry(vertices[i])); };
+  // Consecutive vertices are usually neighbours: each run carries the last boundary face found.
+  const auto run = [&](std::size_t begin, std::size_t end) {
+    TetLocator::Hint hint;
+    for (std::size_t i = begin; i < end; ++i)
+      link.locations[i] = locator.locate(placement.toEntry(vertices[i]), hint);
+  };
   if (vertices.size() >= 1024) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i < r.end(); ++i)
-        one(i);
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256),
+                      [&](const auto& r) { run(r.begin(), r.end()); });
   } else {
-    for (std::size_t i = 0; i < vertices.size(); ++i)
-      one(i);
+    run(0, vertices.size());
   }
   for (TetLocation& l : link.locations)
     if (!l.inside()) {

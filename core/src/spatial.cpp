@@ -51,37 +51,53 @@ double boxSquaredDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 
 }  // namespace
 
-ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) : mSurface(surface) {
-  const auto n = static_cast<std::uint32_t>(mSurface.triangles.size());
+ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) {
+  const auto n = static_cast<std::uint32_t>(surface.triangles.size());
   mOrder.resize(n);
   std::iota(mOrder.begin(), mOrder.end(), 0u);
+  mCorners.resize(n);
   std::vector<Vec3> centroids(n);
   for (std::uint32_t t = 0; t < n; ++t) {
-    const auto& tri = mSurface.triangles[t];
-    centroids[t] = (mSurface.vertices[tri[0]] + mSurface.vertices[tri[1]] + mSurface.vertices[tri[2]]) / 3.0;
+    const auto& tri = surface.triangles[t];
+    mCorners[t] = {surface.vertices[tri[0]], surface.vertices[tri[1]], surface.vertices[tri[2]]};
+    centroids[t] = (mCorners[t].a + mCorners[t].b + mCorners[t].c) / 3.0;
   }
   mNodes.reserve(2 * (n / kLeafSize + 1));
   if (n > 0) build(0, n, centroids);
+  // Corners in leaf order, so that a leaf's triangles sit next to each other.
+  std::vector<Corners> ordered(n);
+  mPosition.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    ordered[i] = mCorners[mOrder[i]];
+    mPosition[mOrder[i]] = i;
+  }
+  mCorners = std::move(ordered);
 }
 
-std::int32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, std::vector<Vec3>& centroids) {
-  Node node;
-  node.min = Vec3::Constant(std::numeric_limits<double>::infinity());
-  node.max = -node.min;
-  Vec3 cmin = node.min, cmax = node.max;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    for (std::uint32_t v : mSurface.triangles[mOrder[i]]) {
-      node.min = node.min.cwiseMin(mSurface.vertices[v]);
-      node.max = node.max.cwiseMax(mSurface.vertices[v]);
+// Splits the triangles mOrder[begin, end) at the median centroid along the centroids' longest extent;
+// boxes are merged bottom-up, so each triangle's corners are read once, at its leaf.
+std::int32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end,
+                                     const std::vector<Vec3>& centroids) {
+  const auto index = static_cast<std::int32_t>(mNodes.size());
+  mNodes.emplace_back();
+  mNodes.back().begin = begin;
+  mNodes.back().end = end;
+  if (end - begin <= kLeafSize) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const Corners& c = mCorners[mOrder[i]];
+      lo = lo.cwiseMin(c.a).cwiseMin(c.b).cwiseMin(c.c);
+      hi = hi.cwiseMax(c.a).cwiseMax(c.b).cwiseMax(c.c);
     }
+    mNodes[static_cast<std::size_t>(index)].min = lo;
+    mNodes[static_cast<std::size_t>(index)].max = hi;
+    return index;
+  }
+  Vec3 cmin = Vec3::Constant(std::numeric_limits<double>::infinity()), cmax = -cmin;
+  for (std::uint32_t i = begin; i < end; ++i) {
     cmin = cmin.cwiseMin(centroids[mOrder[i]]);
     cmax = cmax.cwiseMax(centroids[mOrder[i]]);
   }
-  node.begin = begin;
-  node.end = end;
-  const auto index = static_cast<std::int32_t>(mNodes.size());
-  mNodes.push_back(node);
-  if (end - begin <= kLeafSize) return index;
   int axis = 0;
   (cmax - cmin).maxCoeff(&axis);
   const std::uint32_t mid = begin + (end - begin) / 2;
@@ -89,14 +105,26 @@ std::int32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, std
                    [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
   const std::int32_t left = build(begin, mid, centroids);
   const std::int32_t right = build(mid, end, centroids);
-  mNodes[index].left = left;
-  mNodes[index].right = right;
+  Node& node = mNodes[static_cast<std::size_t>(index)];
+  node.left = left;
+  node.right = right;
+  node.min = mNodes[static_cast<std::size_t>(left)].min.cwiseMin(mNodes[static_cast<std::size_t>(right)].min);
+  node.max = mNodes[static_cast<std::size_t>(left)].max.cwiseMax(mNodes[static_cast<std::size_t>(right)].max);
   return index;
 }
 
 ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p) const {
-  Hit best;
-  double bestSq = std::numeric_limits<double>::infinity();
+  return search(p, Hit{}, std::numeric_limits<double>::infinity());
+}
+
+ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p, std::uint32_t hint) const {
+  if (hint >= mPosition.size()) return closest(p);
+  const Corners& c = mCorners[mPosition[hint]];
+  const TrianglePoint q = closestPointOnTriangle(p, c.a, c.b, c.c);
+  return search(p, Hit{hint, q}, q.squaredDistance);
+}
+
+ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double bestSq) const {
   std::array<std::pair<std::int32_t, double>, 64> stack;
   int top = 0;
   stack[top++] = {0, boxSquaredDistance(p, mNodes[0].min, mNodes[0].max)};
@@ -106,9 +134,8 @@ ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p) const {
     const Node& node = mNodes[index];
     if (node.left < 0) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const auto& tri = mSurface.triangles[mOrder[i]];
-        const TrianglePoint q = closestPointOnTriangle(p, mSurface.vertices[tri[0]],
-                                                       mSurface.vertices[tri[1]], mSurface.vertices[tri[2]]);
+        const Corners& c = mCorners[i];
+        const TrianglePoint q = closestPointOnTriangle(p, c.a, c.b, c.c);
         if (q.squaredDistance < bestSq) {
           bestSq = q.squaredDistance;
           best = {mOrder[i], q};
@@ -189,13 +216,12 @@ TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tet
               static_cast<std::uint32_t>(t);
   }
 
-  TriangleMesh boundary;
-  boundary.vertices = mNodes;
+  mBoundarySurface.vertices = mNodes;
   for (const BoundaryFace& face : boundaryFaces(mesh)) {
-    boundary.triangles.push_back(face.nodes);
+    mBoundarySurface.triangles.push_back(face.nodes);
     mOwner.push_back(face.tet);
   }
-  mBoundary = ClosestPointTree(boundary);
+  mBoundary = ClosestPointTree(mBoundarySurface);
 }
 
 std::array<double, 4> TetLocator::weightsIn(std::uint32_t t, const Vec3& p) const {
@@ -207,6 +233,9 @@ namespace {
 
 /// Barycentric weights count as inside down to this (they are scale-free).
 constexpr double kInsideTolerance = 1e-10;
+/// A point this deep in a tet (every weight above it) is in no other tet of a conforming mesh, to
+/// round-off: the search stops there.
+constexpr double kClearlyInside = 1e-6;
 
 double minWeight(const std::array<double, 4>& w) {
   return std::min(std::min(w[0], w[1]), std::min(w[2], w[3]));
@@ -214,17 +243,26 @@ double minWeight(const std::array<double, 4>& w) {
 
 }  // namespace
 
-TetLocation TetLocator::outside(const Vec3& p) const {
-  const ClosestPointTree::Hit hit = mBoundary.closest(p);
+TetLocation TetLocator::outside(const Vec3& p, Hint* hint) const {
+  const ClosestPointTree::Hit hit = hint ? mBoundary.closest(p, hint->face) : mBoundary.closest(p);
+  if (hint) hint->face = hit.triangle;
   const std::uint32_t t = mOwner[hit.triangle];
   return {t, weightsIn(t, hit.closest.point), std::sqrt(hit.closest.squaredDistance)};
 }
 
 TetLocation TetLocator::locate(const Vec3& p) const {
+  return locate(p, nullptr);
+}
+
+TetLocation TetLocator::locate(const Vec3& p, Hint& hint) const {
+  return locate(p, &hint);
+}
+
+TetLocation TetLocator::locate(const Vec3& p, Hint* hint) const {
   std::array<int, 3> c;
   for (int a = 0; a < 3; ++a) {
     const double u = (p[a] - mOrigin[a]) * mInvCell[a];
-    if (!(u >= 0.0 && u <= mDims[a])) return outside(p);  // also NaN
+    if (!(u >= 0.0 && u <= mDims[a])) return outside(p, hint);  // also NaN
     c[a] = std::min(static_cast<int>(u), mDims[a] - 1);
   }
   const std::size_t cell = (static_cast<std::size_t>(c[2]) * mDims[1] + c[1]) * mDims[0] + c[0];
@@ -237,10 +275,12 @@ TetLocation TetLocator::locate(const Vec3& p) const {
     if (m > bestMin || (m == bestMin && t < best.tet)) {
       bestMin = m;
       best = {t, w, 0.0};
+      // Well inside one tet: the tets of a conforming mesh do not overlap, so no other holds p.
+      if (m > kClearlyInside) return best;
     }
   }
   if (bestMin >= -kInsideTolerance) return best;
-  return outside(p);
+  return outside(p, hint);
 }
 
 TetLocation locateBruteForce(const TetLocator& locator, const Vec3& p) {

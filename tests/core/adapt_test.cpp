@@ -64,6 +64,7 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
   const ClosestPointTree tree(surface);
   const Bounds b = computeBounds(surface);
   std::uniform_real_distribution<double> u(-0.5, 1.5);
+  std::uint32_t previous = 0;
   for (int i = 0; i < 2000; ++i) {
     const Vec3 p = b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent());
     double best = std::numeric_limits<double>::infinity();
@@ -71,13 +72,17 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
       best = std::min(best, closestPointOnTriangle(p, surface.vertices[t[0]], surface.vertices[t[1]],
                                                    surface.vertices[t[2]])
                                 .squaredDistance);
-    const auto hit = tree.closest(p);
-    ASSERT_NEAR(hit.closest.squaredDistance, best, 1e-12 * (1 + best)) << "point " << i;
-    const auto& t = surface.triangles[hit.triangle];
-    const auto& w = hit.closest.barycentric;
-    const Vec3 q =
-        w[0] * surface.vertices[t[0]] + w[1] * surface.vertices[t[1]] + w[2] * surface.vertices[t[2]];
-    ASSERT_LT((q - hit.closest.point).norm(), 1e-9);
+    // Unhinted, hinted by the previous point's answer, and hinted by an arbitrary triangle.
+    const std::uint32_t arbitrary = static_cast<std::uint32_t>(rng() % surface.triangles.size());
+    for (const auto& hit : {tree.closest(p), tree.closest(p, previous), tree.closest(p, arbitrary)}) {
+      ASSERT_NEAR(hit.closest.squaredDistance, best, 1e-12 * (1 + best)) << "point " << i;
+      const auto& t = surface.triangles[hit.triangle];
+      const auto& w = hit.closest.barycentric;
+      const Vec3 q =
+          w[0] * surface.vertices[t[0]] + w[1] * surface.vertices[t[1]] + w[2] * surface.vertices[t[2]];
+      ASSERT_LT((q - hit.closest.point).norm(), 1e-9);
+    }
+    previous = tree.closest(p).triangle;
   }
 }
 
@@ -89,9 +94,11 @@ TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
   EXPECT_EQ(locator.boundary().triangleCount(), 2u * 2 * (6 * 4 + 4 * 3 + 6 * 3));
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int inside = 0;
-  for (int i = 0; i < 4000; ++i) {
+  TetLocator::Hint hint;
+  for (int i = 0; i < 8000; ++i) {
     const Vec3 p(3 + 4.5 * u(rng), 2 + 3.5 * u(rng), 1.5 + 3 * u(rng));
-    const TetLocation fast = locator.locate(p);
+    // Even points with odd ones: a hint from an unrelated point must not change the answer.
+    const TetLocation fast = i % 2 == 0 ? locator.locate(p) : locator.locate(p, hint);
     const TetLocation slow = locateBruteForce(locator, p);
     double sum = 0.0;
     for (double w : fast.weights) {
@@ -111,9 +118,9 @@ TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
       ASSERT_NEAR((interpolate(mesh, fast) - p).norm(), fast.distance, 1e-9);
     }
   }
-  // The grid fills 72 of the sampled 378 units³: about 760 points inside, the rest outside.
-  EXPECT_GT(inside, 500);
-  EXPECT_LT(inside, 1000);
+  // The grid fills 72 of the sampled 378 units³: about 1,520 points inside, the rest outside.
+  EXPECT_GT(inside, 1000);
+  EXPECT_LT(inside, 2000);
 }
 
 TEST(Link, WeightsSumToOneAndReproduceInsideVertices) {

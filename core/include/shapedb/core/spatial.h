@@ -3,6 +3,7 @@
 // of a triangle surface. Both are built once per mesh and then answer queries from many threads.
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <shapedb/core/physics.h>
@@ -21,31 +22,42 @@ struct TrianglePoint {
 TrianglePoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 /// Closest-point queries on a triangle surface: an AABB tree (median split, ≤ 4 triangles a leaf),
-/// searched nearest box first. Immutable once built: concurrent queries are safe. Keeps a copy of the
-/// surface's vertices and triangles.
+/// searched nearest box first. Keeps its own copy of each triangle's corners, in leaf order, so that a
+/// search reads memory in sequence; the surface need not outlive it. Immutable once built: concurrent
+/// queries are safe.
 class ClosestPointTree {
  public:
   ClosestPointTree() = default;
   explicit ClosestPointTree(const TriangleMesh& surface);
 
   struct Hit {
-    std::uint32_t triangle = 0;
+    std::uint32_t triangle = 0;  ///< index in the surface the tree was built from
     TrianglePoint closest;
   };
   /// The closest point of the surface to `p`. Precondition: the surface has a triangle.
   Hit closest(const Vec3& p) const;
-  const TriangleMesh& surface() const { return mSurface; }
-  bool empty() const { return mSurface.triangles.empty(); }
+  /// The same, starting from triangle `hint` (say, the answer for a nearby point): its distance bounds
+  /// the search from the start, so fewer boxes are opened. The same closest point and distance whatever
+  /// the hint; where several triangles are equally close (at a shared edge or vertex) it may name
+  /// another of them.
+  Hit closest(const Vec3& p, std::uint32_t hint) const;
+  bool empty() const { return mOrder.empty(); }
+  std::size_t triangleCount() const { return mOrder.size(); }
 
  private:
   struct Node {
     Vec3 min, max;
-    std::uint32_t begin = 0, end = 0;  ///< leaf: range of mOrder
+    std::uint32_t begin = 0, end = 0;  ///< leaf: range of mOrder and mCorners
     std::int32_t left = -1, right = -1;
   };
-  std::int32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Vec3>& centroids);
-  TriangleMesh mSurface;
-  std::vector<std::uint32_t> mOrder;  ///< triangle indices, leaves contiguous
+  struct Corners {
+    Vec3 a, b, c;
+  };
+  std::int32_t build(std::uint32_t begin, std::uint32_t end, const std::vector<Vec3>& centroids);
+  Hit search(const Vec3& p, Hit best, double bestSq) const;
+  std::vector<std::uint32_t> mOrder;     ///< triangle indices, leaves contiguous
+  std::vector<std::uint32_t> mPosition;  ///< inverse of mOrder: where triangle t sits
+  std::vector<Corners> mCorners;         ///< the triangles' corners, in the order of mOrder
   std::vector<Node> mNodes;
 };
 
@@ -70,9 +82,17 @@ class TetLocator {
   explicit TetLocator(const TetMesh& mesh);
 
   TetLocation locate(const Vec3& p) const;
+  /// Carries the last boundary face found from one locate() to the next: points that follow each other
+  /// on a surface are close, and so are their closest boundary faces. One per thread.
+  struct Hint {
+    std::uint32_t face = std::numeric_limits<std::uint32_t>::max();
+  };
+  /// The same answer as locate(p), faster for a sequence of nearby points (outside the mesh, the
+  /// closest point may be reported in another of the faces sharing it).
+  TetLocation locate(const Vec3& p, Hint& hint) const;
   std::size_t tetCount() const { return mTets.size(); }
   /// The boundary faces, each wound outward, over the mesh's own node indices.
-  const TriangleMesh& boundary() const { return mBoundary.surface(); }
+  const TriangleMesh& boundary() const { return mBoundarySurface; }
   const ClosestPointTree& boundaryTree() const { return mBoundary; }
   /// The tet each boundary face belongs to.
   const std::vector<std::uint32_t>& boundaryOwner() const { return mOwner; }
@@ -81,7 +101,8 @@ class TetLocator {
   friend TetLocation locateBruteForce(const TetLocator& locator, const Vec3& p);
   /// Barycentric weights of p in tet t: {1 − Σ, λ₁, λ₂, λ₃} with λ = inverse(edges) (p − a).
   std::array<double, 4> weightsIn(std::uint32_t t, const Vec3& p) const;
-  TetLocation outside(const Vec3& p) const;
+  TetLocation locate(const Vec3& p, Hint* hint) const;
+  TetLocation outside(const Vec3& p, Hint* hint) const;
 
   std::vector<Vec3> mNodes;
   std::vector<TetMesh::Tet> mTets;
@@ -91,6 +112,7 @@ class TetLocator {
   std::array<int, 3> mDims{};
   std::vector<std::uint32_t> mCellBegin;  ///< CSR: cells + 1 offsets into mCellTets
   std::vector<std::uint32_t> mCellTets;
+  TriangleMesh mBoundarySurface;
   ClosestPointTree mBoundary;
   std::vector<std::uint32_t> mOwner;
 };
