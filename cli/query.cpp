@@ -89,13 +89,10 @@ nlohmann::json physicsJson(const core::AdaptedPhysics& p) {
 }
 
 nlohmann::json timingJson(const io::QueryTimes& t) {
-  return {{"mass_properties", t.massProperties},
-          {"describe", t.describe},
-          {"search", t.search},
-          {"fetch", t.fetch},
-          {"adapt", t.adapt},
-          {"link", t.link},
-          {"fidelity", t.fidelity},
+  return {{"validate", t.validate}, {"mass_properties", t.massProperties},
+          {"describe", t.describe}, {"search", t.search},
+          {"fetch", t.fetch},       {"adapt", t.adapt},
+          {"link", t.link},         {"fidelity", t.fidelity},
           {"total", t.total}};
 }
 
@@ -145,9 +142,10 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
   if (timing) {
     const io::QueryTimes& t = r.times;
     std::printf(
-        "  timing (µs): mass properties %.1f, describe %.1f, search %.1f, fetch %.1f, adapt %.1f, link %.1f, "
-        "fidelity %.1f, total %.1f\n",
-        t.massProperties, t.describe, t.search, t.fetch, t.adapt, t.link, t.fidelity, t.total);
+        "  timing (µs): validate %.1f, mass properties %.1f, describe %.1f (%zu orientations), search %.1f, "
+        "fetch %.1f, adapt %.1f, link %.1f, fidelity %.1f, total %.1f\n",
+        t.validate, t.massProperties, t.describe, r.orientationCandidates, t.search, t.fetch, t.adapt, t.link,
+        t.fidelity, t.total);
   }
 }
 

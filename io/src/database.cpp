@@ -380,7 +380,11 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
 
   Clock::time_point t = Clock::now();
   if (Status valid = core::validateMesh(mesh); !valid) return valid.error();
-  auto mass = core::computeMassProperties(mesh);
+  const core::TopologyReport topology = core::analyzeTopology(mesh);
+  out.times.validate = microsecondsSince(t);
+
+  t = Clock::now();
+  auto mass = core::computeMassProperties(mesh, topology);
   if (!mass) return mass.error();
   out.massProperties = *mass;
   auto normalization = core::normalize(mesh, *mass);
@@ -392,6 +396,7 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   auto candidates =
       mImpl->describer(options.descriptor).describeCandidates(mesh, out.normalization, options.orientation);
   if (!candidates) return candidates.error();
+  out.orientationCandidates = candidates->size();
   out.times.describe = microsecondsSince(t);
 
   t = Clock::now();

@@ -83,7 +83,8 @@ struct QueryOptions {
 
 /// Wall time of each stage of one query, microseconds.
 struct QueryTimes {
-  double massProperties = 0.0;  ///< validate + exact mass properties + normalize
+  double validate = 0.0;        ///< per-face checks and the closed-surface check (analyzeTopology)
+  double massProperties = 0.0;  ///< exact mass properties (surface integrals) + normalize
   double describe = 0.0;        ///< every orientation candidate
   double search = 0.0;
   double fetch = 0.0;  ///< physical data from the cache or the file (with the entry's locator)
@@ -108,6 +109,7 @@ struct QueryResult {
   std::shared_ptr<const core::PhysicalData> entryPhysics;  ///< the best match's, canonical frame
   std::optional<core::AdaptedPhysics> physics;             ///< with QueryOptions::adapt
   core::SurfaceLink link;                                  ///< with QueryOptions::link
+  std::size_t orientationCandidates = 0;                   ///< descriptors searched (orientations)
   QueryTimes times;
 };
 
