@@ -50,6 +50,29 @@ std::string plural(std::size_t n, const std::string& noun, const std::string& no
   return std::to_string(n) + " " + (n == 1 ? noun : nouns.empty() ? noun + "s" : nouns);
 }
 
+// One edge shared by `count` half-edges; `sameDirection`: it has two and they run the same way.
+void countEdge(std::size_t count, bool sameDirection, TopologyReport& report) {
+  ++report.edgeCount;
+  if (count == 1) ++report.boundaryEdges;
+  if (count > 2) ++report.nonManifoldEdges;
+  if (count == 2 && sameDirection) ++report.inconsistentEdges;
+}
+
+// Referenced and unreferenced vertices, and components: the distinct roots among referenced vertices.
+void countVertices(const std::vector<char>& referenced, DisjointSets& sets, TopologyReport& report) {
+  std::vector<char> isRoot(referenced.size(), 0);
+  for (std::uint32_t v = 0; v < referenced.size(); ++v) {
+    if (!referenced[v]) {
+      ++report.unreferencedVertices;
+      continue;
+    }
+    ++report.vertexCount;
+    const std::uint32_t root = sets.find(v);
+    if (!isRoot[root]) ++report.components;
+    isRoot[root] = 1;
+  }
+}
+
 }  // namespace
 
 TopologyReport analyzeTopology(const TriangleMesh& mesh) {
@@ -95,28 +118,14 @@ TopologyReport analyzeTopology(const TriangleMesh& mesh) {
       auto end = begin + 1;
       while (end != last && (*end >> 1) == upper)
         ++end;
-      const auto count = end - begin;
-      ++report.edgeCount;
-      if (count == 1) ++report.boundaryEdges;
-      if (count > 2) ++report.nonManifoldEdges;
-      if (count == 2 && begin[0] == begin[1]) ++report.inconsistentEdges;
+      const auto count = static_cast<std::size_t>(end - begin);
+      countEdge(count, count == 2 && begin[0] == begin[1], report);
       sets.unite(static_cast<std::uint32_t>(v), static_cast<std::uint32_t>(upper));
       begin = end;
     }
   }
 
-  // Components are the distinct roots among referenced vertices.
-  std::vector<char> isRoot(vertexCount, 0);
-  for (std::uint32_t v = 0; v < vertexCount; ++v) {
-    if (!referenced[v]) {
-      ++report.unreferencedVertices;
-      continue;
-    }
-    ++report.vertexCount;
-    const std::uint32_t root = sets.find(v);
-    if (!isRoot[root]) ++report.components;
-    isRoot[root] = 1;
-  }
+  countVertices(referenced, sets, report);
   return report;
 }
 
@@ -151,25 +160,11 @@ TopologyReport analyzeTopologyBySorting(const TriangleMesh& mesh) {
     while (end < halfEdges.size() && halfEdges[end].key == halfEdges[begin].key)
       ++end;
     const std::size_t count = end - begin;
-    ++report.edgeCount;
-    if (count == 1) ++report.boundaryEdges;
-    if (count > 2) ++report.nonManifoldEdges;
-    if (count == 2 && halfEdges[begin].forward == halfEdges[begin + 1].forward) ++report.inconsistentEdges;
+    countEdge(count, count == 2 && halfEdges[begin].forward == halfEdges[begin + 1].forward, report);
     begin = end;
   }
 
-  // Components are the distinct roots among referenced vertices.
-  std::vector<char> isRoot(mesh.vertices.size(), 0);
-  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) {
-    if (!referenced[v]) {
-      ++report.unreferencedVertices;
-      continue;
-    }
-    ++report.vertexCount;
-    const std::uint32_t root = sets.find(v);
-    if (!isRoot[root]) ++report.components;
-    isRoot[root] = 1;
-  }
+  countVertices(referenced, sets, report);
   return report;
 }
 
