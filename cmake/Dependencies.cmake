@@ -1,6 +1,7 @@
 # Every third-party library comes from Debian 12's packages (see scripts/setup.sh).
 list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)  # Debian ships FindOpenVDB.cmake only
 
+find_package(Threads REQUIRED)
 find_package(TBB CONFIG REQUIRED)
 find_package(OpenVDB REQUIRED)
 find_package(Eigen3 3.4 CONFIG REQUIRED)

@@ -1,0 +1,173 @@
+#pragma once
+
+// The haptic-rate loop (DESIGN.md, "The haptic loop"). A dedicated thread ticks at a fixed rate against a
+// steady clock. Each tick reads the proxy, posts the objects that came within the augmentation radius
+// to worker threads (query, fetch, adapt, link: whatever the AugmentFunction does), and picks up the
+// ones the workers have published, through one atomic pointer per object. Augmented objects in contact
+// with the proxy respond through their modes and push back on it. A tick never waits for a worker, and
+// never allocates, locks, logs or throws.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <semaphore>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include <shapedb/core/adapt.h>
+#include <shapedb/core/result.h>
+#include <shapedb/core/spatial.h>
+#include <shapedb/core/triangle_mesh.h>
+#include <shapedb/haptics/device.h>
+#include <shapedb/haptics/modal_step.h>
+
+namespace shapedb::haptics {
+
+/// An object of the scene: a surface mesh in the world frame (metres), nothing more.
+struct SceneObject {
+  std::string name;
+  core::TriangleMesh mesh;
+};
+
+/// What augmentation gives an object: physical data that fit its surface, in the world frame.
+struct AugmentedObject {
+  std::string source;            ///< where the data came from (a database entry's name)
+  core::AdaptedPhysics physics;  ///< tets, modes (M-orthonormal), collision compound, damping
+  core::SurfaceLink link;        ///< the object's surface vertices in physics.tetMesh
+  /// Locates contact points in the tets. It may be built on another copy of the same tets (a database
+  /// entry's canonical ones, shared by every object that matched it): `locatorFrame` carries the
+  /// locator's frame to the world, and its tets are numbered as physics.tetMesh's.
+  std::shared_ptr<const core::TetLocator> locator;
+  core::Placement locatorFrame;
+};
+
+/// Runs on a worker thread: may take milliseconds, allocate, read files. An error leaves the object
+/// without physical data (reported, never retried).
+using AugmentFunction = std::function<Result<AugmentedObject>(const SceneObject&)>;
+
+struct LoopOptions {
+  double rateHz = 1000.0;
+  /// An object is augmented when the proxy comes this close to its bounding sphere (metres).
+  double augmentationRadius = 0.05;
+  double proxyRadius = 0.005;  ///< the proxy is a sphere (metres)
+  double stiffness = 2000.0;   ///< contact penalty, N/m
+  double maxForce = 10.0;      ///< the device's limit, N
+  int workers = 1;             ///< augmentation threads (run() only)
+  /// run(): sleep until this close to a tick's start, then spin on the clock.
+  double spinSeconds = 200e-6;
+  /// simulate(): the simulated time from an object's request to its data being ready.
+  double simulatedAugmentationSeconds = 0.02;
+  /// Keep the force of every tick in LoopReport::forces.
+  bool recordForces = false;
+};
+
+struct Percentiles {
+  double p50 = 0.0, p99 = 0.0, max = 0.0;
+};
+
+struct ObjectOutcome {
+  std::string name;
+  enum class State : std::uint8_t { kUntouched, kPending, kReady, kFailed } state = State::kUntouched;
+  std::string source;                ///< kReady: where the data came from
+  std::string error;                 ///< kFailed: why
+  double augmentationSeconds = 0.0;  ///< kReady: entering the radius → data published
+};
+
+struct LoopReport {
+  double seconds = 0.0;  ///< of the run (wall clock, or simulated)
+  std::size_t ticks = 0;
+  double achievedRateHz = 0.0;
+  Percentiles tickMicros;          ///< compute time of a tick (wall clock, also in simulate())
+  std::size_t deadlineMisses = 0;  ///< ticks that ended after their period did (run() only)
+  bool realtimePriority = false;   ///< run(): the loop thread got SCHED_FIFO
+  Percentiles augmentationMillis;  ///< entering the radius → data ready, over the objects augmented
+  std::size_t objectsAugmented = 0, objectsFailed = 0, objectsPending = 0;
+  std::size_t contactTicks = 0;  ///< ticks with a force on the proxy
+  double maxForce = 0.0;         ///< N
+  std::vector<ObjectOutcome> objects;
+  std::vector<core::Vec3> forces;  ///< per tick, with LoopOptions::recordForces
+};
+
+/// One loop over a scene. The objects and the device must outlive it. Not copyable or movable.
+class HapticLoop {
+ public:
+  /// Errors: kInvalidArgument for options out of range or an empty object mesh.
+  static Result<std::unique_ptr<HapticLoop>> create(std::span<const SceneObject> objects, ProxyDevice& device,
+                                                    AugmentFunction augment, const LoopOptions& options);
+  ~HapticLoop();
+  HapticLoop(const HapticLoop&) = delete;
+  HapticLoop& operator=(const HapticLoop&) = delete;
+
+  /// Ticks in real time on a dedicated thread for `seconds`, with options.workers augmenting beside it;
+  /// blocks until done. Objects augmented stay so for the next run.
+  LoopReport run(double seconds);
+
+  /// The same loop on a simulated clock, in the calling thread: tick k at k / rateHz, and a request made
+  /// at time t is served (in this thread) at the first tick after t + simulatedAugmentationSeconds.
+  /// Deterministic: the same inputs give the same forces, to the bit.
+  LoopReport simulate(double seconds);
+
+  /// One tick at `seconds`, for a caller that runs its own clock (run() and simulate() keep theirs: it
+  /// does not move). Allocation- and lock-free. The requests it posts are served by run()'s workers or
+  /// by simulate(); until then they wait. Returns the force sent to the device.
+  core::Vec3 tick(double seconds);
+
+  std::size_t objectCount() const { return mObjects.size(); }
+  /// The object's physical data once augmented, else null. Any thread.
+  const AugmentedObject* augmentation(std::size_t object) const;
+  /// The object's modal coordinates as the last tick left them (a consistent snapshot, any thread);
+  /// empty before augmentation.
+  Eigen::VectorXd modalCoordinates(std::size_t object) const;
+  /// The object's surface displaced by its current modal coordinates (through the linking weights);
+  /// its rest surface before augmentation.
+  std::vector<core::Vec3> deformedSurface(std::size_t object) const;
+
+ private:
+  struct Live;
+  struct Slot;
+  HapticLoop(std::span<const SceneObject> objects, ProxyDevice& device, AugmentFunction augment,
+             const LoopOptions& options);
+  /// Augments and publishes; `readySeconds` stamps the time (none: now, on run()'s clock).
+  void serve(std::uint32_t object, std::optional<double> readySeconds);
+  void workerMain();
+  std::uint32_t popRequest();  ///< UINT32_MAX when none
+  void respond(Slot& slot, Live& live, const core::Vec3& proxy, core::Vec3& force);
+  LoopReport report(double seconds, std::size_t ticks, std::size_t misses) const;
+  void resetStatistics(std::size_t expectedTicks);
+
+  std::span<const SceneObject> mObjects;
+  ProxyDevice& mDevice;
+  AugmentFunction mAugment;
+  LoopOptions mOptions;
+  double mPeriod = 0.001;
+
+  std::unique_ptr<Slot[]> mSlots;
+  // Requests: written by the tick (one producer), read by the workers under mPopMutex. Each object is
+  // requested once, so a ring of one place per object never wraps.
+  std::vector<std::uint32_t> mRequests;
+  std::atomic<std::uint32_t> mRequestsWritten{0};
+  std::uint32_t mRequestsRead = 0;  ///< guarded by mPopMutex
+  std::mutex mPopMutex;             ///< workers only: the tick never takes it
+  std::counting_semaphore<> mPending{0};
+  std::atomic<bool> mStopping{false};
+  double mClockOffset = 0.0;  ///< seconds of earlier runs: the loop's time goes on from one run to the next
+  std::chrono::steady_clock::time_point mRunStart;  ///< run(): set before the workers start
+  double mRunOffset = 0.0;
+
+  // The tick's own state (one thread at a time).
+  std::vector<std::uint32_t> mActive;  ///< objects in contact or still vibrating; capacity: all
+  std::vector<float> mTickMicros;      ///< capacity reserved before the ticks
+  std::vector<core::Vec3> mForces;
+  std::size_t mContactTicks = 0;
+  double mMaxForce = 0.0;
+};
+
+}  // namespace shapedb::haptics

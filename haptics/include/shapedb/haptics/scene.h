@@ -1,0 +1,27 @@
+#pragma once
+
+// Scenes from files and augmentation from a shape database: what turns the loop of loop.h into
+// `shapedb haptic`. Part of shapedb::haptics_io (the loop itself needs only core).
+
+#include <filesystem>
+#include <vector>
+
+#include <shapedb/core/result.h>
+#include <shapedb/haptics/loop.h>
+#include <shapedb/io/database.h>
+
+namespace shapedb::haptics {
+
+/// Every mesh file (OBJ, PLY, OFF, STL) directly in `directory`, in name order, each an object in the
+/// world frame (metres) named after its file. A file that does not read is an error naming it; a mesh
+/// that reads but cannot be queried (say, open) is loaded, and its augmentation fails in the loop with
+/// that reason. Errors: kIo (not a directory, or no mesh in it), and loadMesh's.
+Result<std::vector<SceneObject>> loadScene(const std::filesystem::path& directory);
+
+/// Augmentation by the database (Algorithm 1): query, fetch, adapt to `options.material`, link. The
+/// contact locator is the entry's own, shared through the database's cache. `options.adapt` and
+/// `options.link` are forced on. The database must outlive the function; it is safe to call from
+/// several workers at once.
+AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions options);
+
+}  // namespace shapedb::haptics

@@ -1,0 +1,63 @@
+#include <algorithm>
+#include <cctype>
+#include <string>
+#include <system_error>
+
+#include <shapedb/haptics/scene.h>
+#include <shapedb/io/mesh_io.h>
+
+namespace shapedb::haptics {
+
+namespace fs = std::filesystem;
+
+Result<std::vector<SceneObject>> loadScene(const fs::path& directory) {
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec))
+    return Error{ErrorCode::kIo, directory.string() + ": not a directory (a scene is a directory of meshes)"};
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+    std::string extension = entry.path().extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (entry.is_regular_file() &&
+        (extension == ".obj" || extension == ".ply" || extension == ".off" || extension == ".stl"))
+      files.push_back(entry.path());
+  }
+  if (ec) return Error{ErrorCode::kIo, directory.string() + ": " + ec.message()};
+  if (files.empty())
+    return Error{ErrorCode::kIo,
+                 directory.string() + ": no mesh files (.obj, .ply, .off, .stl) in the scene"};
+  std::sort(files.begin(), files.end());
+
+  std::vector<SceneObject> objects;
+  objects.reserve(files.size());
+  for (const fs::path& file : files) {
+    Result<io::LoadedMesh> loaded = io::loadMesh(file);
+    if (!loaded) return loaded.error();  // names the file
+    objects.push_back({file.filename().string(), std::move(loaded->mesh)});
+  }
+  return objects;
+}
+
+AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions options) {
+  options.adapt = true;
+  options.link = true;
+  return [&database, options](const SceneObject& object) -> Result<AugmentedObject> {
+    Result<io::QueryResult> result = database.query(object.mesh, options);
+    if (!result) return withContext(result.error(), object.name);
+    if (result->matches.empty() || !result->physics)
+      return Error{ErrorCode::kInvalidArgument, object.name + ": the database gave no match"};
+    const io::MatchReport& best = result->matches.front();
+    Result<std::shared_ptr<const core::TetLocator>> locator = database.locator(best.match.entry);
+    if (!locator) return withContext(locator.error(), object.name);
+    AugmentedObject augmented;
+    augmented.source = best.entry ? best.entry->name : std::to_string(best.match.entry);
+    augmented.physics = std::move(*result->physics);
+    augmented.link = std::move(result->link);
+    augmented.locator = std::move(*locator);
+    augmented.locatorFrame = augmented.physics.placement;
+    return augmented;
+  };
+}
+
+}  // namespace shapedb::haptics
