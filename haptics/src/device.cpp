@@ -58,19 +58,20 @@ Result<TrajectoryDevice> TrajectoryDevice::fromCsv(const std::filesystem::path& 
   return device;
 }
 
-TrajectoryDevice TrajectoryDevice::sweep(const Vec3& boxMin, const Vec3& boxMax, int lanes, double seconds) {
+TrajectoryDevice TrajectoryDevice::sweep(const Vec3& boxMin, const Vec3& boxMax, int lanes, double speed) {
   lanes = std::max(lanes, 1);
   const double z = 0.5 * (boxMin.z() + boxMax.z());
   std::vector<Keyframe> keyframes;
-  // Each lane is a pass along x; the short moves between lanes take no time of their own.
-  const double laneSeconds = seconds / lanes;
+  double t = 0.0;
   for (int lane = 0; lane < lanes; ++lane) {
     const double y = lanes == 1 ? 0.5 * (boxMin.y() + boxMax.y())
                                 : boxMin.y() + (boxMax.y() - boxMin.y()) * lane / (lanes - 1);
     const bool forward = lane % 2 == 0;
-    const double x0 = forward ? boxMin.x() : boxMax.x(), x1 = forward ? boxMax.x() : boxMin.x();
-    keyframes.push_back({lane * laneSeconds, Vec3(x0, y, z)});
-    keyframes.push_back({(lane + 1) * laneSeconds, Vec3(x1, y, z)});
+    const Vec3 from(forward ? boxMin.x() : boxMax.x(), y, z), to(forward ? boxMax.x() : boxMin.x(), y, z);
+    if (!keyframes.empty()) t += (from - keyframes.back().position).norm() / speed;
+    keyframes.push_back({t, from});
+    t += (to - from).norm() / speed;
+    keyframes.push_back({t, to});
   }
   return TrajectoryDevice(std::move(keyframes));
 }

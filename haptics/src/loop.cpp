@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <pthread.h>
+#include <sys/resource.h>
 
 #include <shapedb/haptics/contact.h>
 #include <shapedb/haptics/loop.h>
@@ -55,7 +56,7 @@ struct HapticLoop::Live {
   Vec3 center = Vec3::Zero();
   double reach = 0.0;  ///< bounding radius of the collision compound about `center`
   core::TetLocator::Hint hint;
-  // Seqlock: odd while the tick writes `snapshot`.
+  // Seqlock, without fences (ThreadSanitizer does not model them): odd while the tick writes `snapshot`.
   std::atomic<std::uint32_t> sequence{0};
   std::unique_ptr<std::atomic<double>[]> snapshot;
 };
@@ -126,9 +127,10 @@ Eigen::VectorXd HapticLoop::modalCoordinates(std::size_t object) const {
   for (;;) {
     const std::uint32_t before = live->sequence.load(std::memory_order_acquire);
     if (before % 2 == 0) {
+      // Acquire loads: the second read of the sequence cannot move before them, and a value written after
+      // the sequence turned odd brings that odd sequence with it.
       for (Eigen::Index j = 0; j < q.size(); ++j)
-        q[j] = live->snapshot[j].load(std::memory_order_relaxed);
-      std::atomic_thread_fence(std::memory_order_acquire);
+        q[j] = live->snapshot[j].load(std::memory_order_acquire);
       if (live->sequence.load(std::memory_order_relaxed) == before) return q;
     }
     std::this_thread::yield();
@@ -266,8 +268,8 @@ Vec3 HapticLoop::tick(double seconds) {
     Live& live = *mSlots[mActive[a]].owned;
     double energy = 0.0;
     const Eigen::Index modes = live.q.size();
-    live.sequence.store(live.sequence.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
+    const std::uint32_t sequence = live.sequence.load(std::memory_order_relaxed);
+    live.sequence.store(sequence + 1, std::memory_order_relaxed);  // odd: the snapshot is being written
     for (Eigen::Index j = 0; j < modes; ++j) {
       live.steps[static_cast<std::size_t>(j)].advance(live.q[j], live.v[j], live.force[j]);
       live.force[j] = 0.0;
@@ -280,9 +282,10 @@ Vec3 HapticLoop::tick(double seconds) {
       live.v.setZero();
       live.peakEnergy = 0.0;
     }
+    // Release stores (plain moves on x86): a reader that sees one of these values sees the odd sequence.
     for (Eigen::Index j = 0; j < modes; ++j)
-      live.snapshot[j].store(live.q[j], std::memory_order_relaxed);
-    live.sequence.store(live.sequence.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+      live.snapshot[j].store(live.q[j], std::memory_order_release);
+    live.sequence.store(sequence + 2, std::memory_order_release);
     live.touched = false;
     if (rest) {
       live.active = false;
@@ -303,10 +306,16 @@ Vec3 HapticLoop::tick(double seconds) {
 }
 
 void HapticLoop::resetStatistics(std::size_t expectedTicks) {
+  // Filled once and cleared: the pages are touched now, so that the ticks do not fault them in.
+  mTickMicros.assign(expectedTicks, 0.0f);
   mTickMicros.clear();
-  mTickMicros.reserve(expectedTicks);
+  mLateMicros.assign(expectedTicks, 0.0f);
+  mLateMicros.clear();
   mForces.clear();
-  if (mOptions.recordForces) mForces.reserve(expectedTicks);
+  if (mOptions.recordForces) {
+    mForces.assign(expectedTicks, Vec3::Zero());
+    mForces.clear();
+  }
   mContactTicks = 0;
   mMaxForce = 0.0;
 }
@@ -335,11 +344,14 @@ LoopReport HapticLoop::run(double seconds) {
 
   std::size_t misses = 0, done = 0;
   bool realtime = false;
+  std::size_t pageFaults = 0;
   std::thread loop([&] {
     // Real-time scheduling where the system grants it (root, or CAP_SYS_NICE); else the default.
     sched_param priority{};
     priority.sched_priority = 10;
     realtime = pthread_setschedparam(pthread_self(), SCHED_FIFO, &priority) == 0;
+    rusage before{};
+    getrusage(RUSAGE_THREAD, &before);
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(mPeriod));
     const auto spin =
         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(mOptions.spinSeconds));
@@ -351,8 +363,10 @@ LoopReport HapticLoop::run(double seconds) {
       const Clock::time_point begin = Clock::now();
       tick(offset + secondsBetween(start, next));
       const Clock::time_point end = Clock::now();
-      if (mTickMicros.size() < mTickMicros.capacity())
+      if (mTickMicros.size() < mTickMicros.capacity()) {
         mTickMicros.push_back(static_cast<float>(1e6 * secondsBetween(begin, end)));
+        mLateMicros.push_back(static_cast<float>(1e6 * secondsBetween(next, begin)));
+      }
       ++done;
       next += period;
       if (end > next) ++misses;  // finished after its own period ended
@@ -364,6 +378,10 @@ LoopReport HapticLoop::run(double seconds) {
         k += behind;
       }
     }
+    rusage after{};
+    getrusage(RUSAGE_THREAD, &after);
+    pageFaults =
+        static_cast<std::size_t>((after.ru_minflt - before.ru_minflt) + (after.ru_majflt - before.ru_majflt));
   });
   loop.join();
   mStopping.store(true, std::memory_order_release);
@@ -373,6 +391,7 @@ LoopReport HapticLoop::run(double seconds) {
   mClockOffset = offset + seconds;
   LoopReport result = report(seconds, done, misses);
   result.realtimePriority = realtime;
+  result.pageFaults = pageFaults;
   return result;
 }
 
@@ -406,6 +425,7 @@ LoopReport HapticLoop::report(double seconds, std::size_t ticks, std::size_t mis
   r.ticks = ticks;
   r.achievedRateHz = seconds > 0.0 ? static_cast<double>(ticks) / seconds : 0.0;
   r.tickMicros = percentiles(std::vector<double>(mTickMicros.begin(), mTickMicros.end()));
+  r.startLateMicros = percentiles(std::vector<double>(mLateMicros.begin(), mLateMicros.end()));
   r.deadlineMisses = misses;
   r.contactTicks = mContactTicks;
   r.maxForce = mMaxForce;

@@ -161,12 +161,15 @@ TEST(Device, CsvErrorsNameTheFileAndLine) {
     std::filesystem::remove(p);
 }
 
-TEST(Device, SweepRunsEveryLaneAcrossTheBox) {
-  TrajectoryDevice sweep = TrajectoryDevice::sweep(Vec3(0, 0, 0), Vec3(4, 2, 1), 3, 6.0);
+TEST(Device, SweepRunsEveryLaneAcrossTheBoxAtItsSpeed) {
+  // Lanes 4 m long, 1 m apart, at 2 m/s: 2 s a lane, 0.5 s between lanes.
+  TrajectoryDevice sweep = TrajectoryDevice::sweep(Vec3(0, 0, 0), Vec3(4, 2, 1), 3, 2.0);
   EXPECT_LT((sweep.position(0.0) - Vec3(0, 0, 0.5)).norm(), 1e-15);
   EXPECT_LT((sweep.position(1.0) - Vec3(2, 0, 0.5)).norm(), 1e-15);
-  EXPECT_LT((sweep.position(3.0) - Vec3(2, 1, 0.5)).norm(), 1e-15);  // second lane, coming back
-  EXPECT_LT((sweep.position(6.0) - Vec3(4, 2, 0.5)).norm(), 1e-15);
+  EXPECT_LT((sweep.position(2.25) - Vec3(4, 0.5, 0.5)).norm(), 1e-15);  // moving to the next lane
+  EXPECT_LT((sweep.position(3.5) - Vec3(2, 1, 0.5)).norm(), 1e-15);     // second lane, coming back
+  EXPECT_LT((sweep.position(7.0) - Vec3(4, 2, 0.5)).norm(), 1e-15);
+  EXPECT_LT((sweep.position(100.0) - Vec3(4, 2, 0.5)).norm(), 1e-15);
 }
 
 }  // namespace

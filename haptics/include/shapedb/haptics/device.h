@@ -35,10 +35,10 @@ class TrajectoryDevice final : public ProxyDevice {
   /// CSV playback: one keyframe per line, "t,x,y,z" (seconds, metres); a header line and blank lines
   /// are skipped. Errors: kIo, or kParse naming the file and line.
   static Result<TrajectoryDevice> fromCsv(const std::filesystem::path& path);
-  /// A back-and-forth sweep through a box at the height of its centre: `lanes` passes along x, evenly
-  /// spaced over the box's y extent (lanes ≥ 1), the whole sweep taking `seconds`.
-  static TrajectoryDevice sweep(const core::Vec3& boxMin, const core::Vec3& boxMax, int lanes,
-                                double seconds);
+  /// A back-and-forth sweep through a box at the height of its centre, at `speed` m/s: `lanes` passes
+  /// along x (lanes ≥ 1), evenly spaced over the box's y extent, joined by moves along y. It starts at
+  /// boxMin's x and y, at time 0, and holds its last position once done.
+  static TrajectoryDevice sweep(const core::Vec3& boxMin, const core::Vec3& boxMax, int lanes, double speed);
 
   core::Vec3 position(double seconds) override;
   void applyForce(double seconds, const core::Vec3& force) override;

@@ -86,8 +86,10 @@ struct LoopReport {
   std::size_t ticks = 0;
   double achievedRateHz = 0.0;
   Percentiles tickMicros;          ///< compute time of a tick (wall clock, also in simulate())
+  Percentiles startLateMicros;     ///< run(): how late a tick started after its scheduled time
   std::size_t deadlineMisses = 0;  ///< ticks that ended after their period did (run() only)
   bool realtimePriority = false;   ///< run(): the loop thread got SCHED_FIFO
+  std::size_t pageFaults = 0;      ///< run(): page faults of the loop thread (each can stall it)
   Percentiles augmentationMillis;  ///< entering the radius → data ready, over the objects augmented
   std::size_t objectsAugmented = 0, objectsFailed = 0, objectsPending = 0;
   std::size_t contactTicks = 0;  ///< ticks with a force on the proxy
@@ -165,6 +167,7 @@ class HapticLoop {
   // The tick's own state (one thread at a time).
   std::vector<std::uint32_t> mActive;  ///< objects in contact or still vibrating; capacity: all
   std::vector<float> mTickMicros;      ///< capacity reserved before the ticks
+  std::vector<float> mLateMicros;      ///< run(): how late each tick started
   std::vector<core::Vec3> mForces;
   std::size_t mContactTicks = 0;
   double mMaxForce = 0.0;
