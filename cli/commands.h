@@ -28,6 +28,7 @@ Command addBuildCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addAddCommand(CLI::App& parent);
 Command addQueryCommand(CLI::App& parent);
+Command addHapticCommand(CLI::App& parent);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);

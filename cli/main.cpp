@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
                                         shapedb::volume::openVdbVersion() + ")");
   app.require_subcommand(1);
   std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
-                                   addInfoCommand(app),    addAddCommand(app),      addQueryCommand(app)};
+                                   addInfoCommand(app),    addAddCommand(app),      addQueryCommand(app),
+                                   addHapticCommand(app)};
 
   try {
     app.parse(argc, argv);

@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "format.h"
+#include "material_flags.h"
 
 namespace shapedb::cli {
 namespace {
@@ -28,8 +29,7 @@ struct QueryCommandOptions {
   int k = 1;
   std::string descriptor = "centroid-voxel";
   std::string method = "pruned";
-  std::string material = "steel";
-  double density = 0.0, youngs = 0.0, poisson = 0.0;
+  MaterialFlags material;
   bool json = false;
   bool timing = false;
   bool noFidelity = false;
@@ -223,29 +223,9 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
                           : o.method == "buckets"   ? core::SearchMethod::kBuckets
                                                     : core::SearchMethod::kPruned;
   options.fidelity = !o.noFidelity;
-  const bool custom = app.count("--density") + app.count("--youngs") + app.count("--poisson") > 0;
-  if (custom) {
-    if (app.count("--material")) {
-      printError("--material and --density/--youngs/--poisson exclude each other");
-      return kExitUsage;
-    }
-    if (!app.count("--density") || !app.count("--youngs")) {
-      printError("a custom material needs --density and --youngs (--poisson defaults to 0.3)");
-      return kExitUsage;
-    }
-    options.material = {"custom", o.density, o.youngs, app.count("--poisson") ? o.poisson : 0.3};
-    if (Status st = core::validateMaterial(options.material); !st) {
-      printError(st.error().message);
-      return kExitUsage;
-    }
-  } else {
-    auto m = core::materialPreset(o.material);
-    if (!m) {
-      printError(m.error().message);
-      return kExitUsage;
-    }
-    options.material = *m;
-  }
+  const std::optional<core::Material> material = resolveMaterial(o.material, app);
+  if (!material) return kExitUsage;
+  options.material = *material;
 
   auto db = io::Database::open(o.database);
   if (!db) {
@@ -330,12 +310,7 @@ Command addQueryCommand(CLI::App& parent) {
                   "Search: pruned (exact, fast), brute-force (the oracle), buckets (the paper's heuristic)")
       ->capture_default_str()
       ->check(CLI::IsMember({"pruned", "brute-force", "buckets"}));
-  app->add_option("--material", o->material,
-                  "Material preset: steel, aluminium, glass, wood, rubber, concrete")
-      ->capture_default_str();
-  app->add_option("--density", o->density, "Custom material: density, kg/m³");
-  app->add_option("--youngs", o->youngs, "Custom material: Young's modulus, Pa");
-  app->add_option("--poisson", o->poisson, "Custom material: Poisson ratio (default 0.3)");
+  addMaterialFlags(*app, o->material);
   app->add_flag(
       "--json", o->json,
       "Print one JSON object: {database, queries: [{file, matches: [{entry_id, name, family, distance,\n"

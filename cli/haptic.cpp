@@ -1,0 +1,238 @@
+// shapedb haptic: the fixed-rate loop over a scene of surface meshes, augmented from a database as the
+// proxy comes near, with a JSON report of its timing.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <shapedb/core/descriptor.h>
+#include <shapedb/haptics/scene.h>
+#include <shapedb/io/database.h>
+
+#include "commands.h"
+#include "material_flags.h"
+
+namespace shapedb::cli {
+namespace {
+
+struct HapticCommandOptions {
+  std::string database;
+  std::string scene;
+  std::string trajectory;
+  std::string report;
+  std::string descriptor = "centroid-voxel";
+  MaterialFlags material;
+  haptics::LoopOptions loop;
+  double seconds = 10.0;
+  double speed = 0.5;
+  bool simulate = false;
+};
+
+nlohmann::json percentilesJson(const haptics::Percentiles& p) {
+  return {{"p50", p.p50}, {"p99", p.p99}, {"max", p.max}};
+}
+
+const char* stateName(haptics::ObjectOutcome::State state) {
+  switch (state) {
+    case haptics::ObjectOutcome::State::kUntouched:
+      return "untouched";
+    case haptics::ObjectOutcome::State::kPending:
+      return "pending";
+    case haptics::ObjectOutcome::State::kReady:
+      return "augmented";
+    case haptics::ObjectOutcome::State::kFailed:
+      return "failed";
+  }
+  return "?";
+}
+
+nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopReport& r,
+                          const core::Material& material) {
+  nlohmann::json objects = nlohmann::json::array();
+  for (const haptics::ObjectOutcome& object : r.objects) {
+    nlohmann::json j = {{"name", object.name}, {"state", stateName(object.state)}};
+    if (object.state == haptics::ObjectOutcome::State::kReady) {
+      j["entry"] = object.source;
+      j["augmentation_latency_ms"] = 1e3 * object.augmentationSeconds;
+    }
+    if (object.state == haptics::ObjectOutcome::State::kFailed) j["error"] = object.error;
+    objects.push_back(std::move(j));
+  }
+  return {{"database", o.database},
+          {"scene", o.scene},
+          {"clock", o.simulate ? "simulated" : "steady"},
+          {"rate_hz", o.loop.rateHz},
+          {"seconds", r.seconds},
+          {"ticks", r.ticks},
+          {"achieved_rate_hz", r.achievedRateHz},
+          {"tick_us", percentilesJson(r.tickMicros)},
+          {"tick_start_late_us", percentilesJson(r.startLateMicros)},
+          {"deadline_misses", r.deadlineMisses},
+          {"realtime_priority", r.realtimePriority},
+          {"loop_page_faults", r.pageFaults},
+          {"augmentation_latency_ms", percentilesJson(r.augmentationMillis)},
+          {"objects_augmented", r.objectsAugmented},
+          {"objects_failed", r.objectsFailed},
+          {"objects_pending", r.objectsPending},
+          {"contact_ticks", r.contactTicks},
+          {"max_force_n", r.maxForce},
+          {"material", material.name},
+          {"options",
+           {{"augmentation_radius_m", o.loop.augmentationRadius},
+            {"proxy_radius_m", o.loop.proxyRadius},
+            {"stiffness_n_per_m", o.loop.stiffness},
+            {"max_force_n", o.loop.maxForce},
+            {"workers", o.loop.workers},
+            {"descriptor", o.descriptor}}},
+          {"objects", std::move(objects)}};
+}
+
+/// The default proxy path: back and forth through the scene's bounding box at mid height, one lane per
+/// typical object width, at `speed` m/s (as far as the run goes).
+haptics::TrajectoryDevice defaultSweep(const std::vector<haptics::SceneObject>& objects, double speed) {
+  core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<double> widths;
+  for (const haptics::SceneObject& object : objects) {
+    const core::Bounds b = core::computeBounds(object.mesh);
+    lo = lo.cwiseMin(b.min);
+    hi = hi.cwiseMax(b.max);
+    widths.push_back((b.max - b.min).head<2>().maxCoeff());
+  }
+  std::nth_element(widths.begin(), widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2),
+                   widths.end());
+  const double width = std::max(widths[widths.size() / 2], 1e-9);
+  const int lanes = std::clamp(static_cast<int>(std::ceil((hi.y() - lo.y()) / width)), 1, 200);
+  return haptics::TrajectoryDevice::sweep(lo, hi, lanes, speed);
+}
+
+int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
+  const std::optional<core::Material> material = resolveMaterial(o.material, app);
+  if (!material) return kExitUsage;
+
+  auto scene = haptics::loadScene(o.scene);
+  if (!scene) {
+    printError(scene.error().message);
+    return kExitInputError;
+  }
+  auto db = io::Database::open(o.database);
+  if (!db) {
+    printError(db.error().message);
+    return kExitInputError;
+  }
+  std::optional<haptics::TrajectoryDevice> device;
+  if (o.trajectory.empty()) {
+    device = defaultSweep(*scene, o.speed);
+  } else {
+    auto played = haptics::TrajectoryDevice::fromCsv(o.trajectory);
+    if (!played) {
+      printError(played.error().message);
+      return kExitInputError;
+    }
+    device = std::move(*played);
+  }
+
+  io::QueryOptions query;
+  query.descriptor = *core::parseDescriptorKind(o.descriptor);
+  query.material = *material;
+  query.fidelity = false;  // the loop needs the data, not the report; it would double the latency
+  auto loop = haptics::HapticLoop::create(*scene, *device, haptics::databaseAugmenter(*db, query), o.loop);
+  if (!loop) {
+    printError(loop.error().message);
+    return kExitUsage;
+  }
+  std::fprintf(stderr, "haptic: %zu objects, %.0f Hz for %.3g s (%s clock), %d worker%s...\n", scene->size(),
+               o.loop.rateHz, o.seconds, o.simulate ? "simulated" : "steady", o.loop.workers,
+               o.loop.workers == 1 ? "" : "s");
+  const haptics::LoopReport r = o.simulate ? (*loop)->simulate(o.seconds) : (*loop)->run(o.seconds);
+
+  const nlohmann::json j = reportJson(o, r, *material);
+  {
+    std::ofstream out(o.report);
+    out << j.dump(2) << '\n';
+    if (!out) {
+      printError(o.report + ": cannot write the report");
+      return kExitInputError;
+    }
+  }
+  std::printf(
+      "ticks %zu at %.1f Hz (asked %.0f), tick µs p50 %.2f p99 %.2f max %.2f, deadline misses %zu%s\n",
+      r.ticks, r.achievedRateHz, o.loop.rateHz, r.tickMicros.p50, r.tickMicros.p99, r.tickMicros.max,
+      r.deadlineMisses, o.simulate ? " (simulated clock)" : "");
+  std::printf("objects %zu: %zu augmented, %zu failed, %zu pending; augmentation ms p50 %.2f p99 %.2f\n",
+              r.objects.size(), r.objectsAugmented, r.objectsFailed, r.objectsPending,
+              r.augmentationMillis.p50, r.augmentationMillis.p99);
+  std::printf("contact in %zu ticks, largest force %.3g N; report: %s\n", r.contactTicks, r.maxForce,
+              o.report.c_str());
+  for (const haptics::ObjectOutcome& object : r.objects)
+    if (object.state == haptics::ObjectOutcome::State::kFailed)
+      std::fprintf(stderr, "haptic: %s: not augmented: %s\n", object.name.c_str(), object.error.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command addHapticCommand(CLI::App& parent) {
+  auto o = std::make_shared<HapticCommandOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "haptic",
+      "Run the fixed-rate haptic loop over a scene of surface meshes: a proxy sphere moves through the "
+      "scene\n"
+      "(a CSV trajectory, or by default a sweep through it); objects it comes near are given physical data\n"
+      "from the database by worker threads (query, adapt, link) while the loop keeps its rate; objects it\n"
+      "touches push back through their collision compound and vibrate through their modes. Writes a JSON\n"
+      "report: achieved rate, tick time percentiles, deadline misses, augmentation latency, per-object\n"
+      "outcome. Objects that cannot be augmented (say, open meshes) are reported, not fatal.");
+  app->add_option("DB", o->database, "Database file (shapedb build)")->required();
+  app->add_option(
+         "SCENE_DIR", o->scene,
+         "Directory of surface meshes (.obj, .ply, .off, .stl), each an object in world coordinates, "
+         "metres")
+      ->required();
+  app->add_option("--report", o->report, "JSON report file")->required();
+  app->add_option("--rate", o->loop.rateHz, "Loop rate, Hz")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e5));
+  app->add_option("--seconds", o->seconds, "How long to run")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 1e5));
+  app->add_option("--trajectory", o->trajectory,
+                  "Proxy path as CSV lines 't,x,y,z' (seconds, metres), linearly interpolated")
+      ->check(CLI::ExistingFile);
+  app->add_option("--speed", o->speed,
+                  "Without --trajectory: the proxy sweeps the scene row by row at this speed, m/s")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 1e3));
+  app->add_option("--radius", o->loop.augmentationRadius,
+                  "Augmentation radius: objects this close to the proxy get physical data, m")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  app->add_option("--proxy-radius", o->loop.proxyRadius, "Radius of the proxy sphere, m")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-9, 1e6));
+  app->add_option("--stiffness", o->loop.stiffness, "Contact stiffness, N/m")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-9, 1e12));
+  app->add_option("--max-force", o->loop.maxForce, "The device's force limit, N")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-9, 1e6));
+  app->add_option("--workers", o->loop.workers, "Augmentation threads")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  app->add_option("--descriptor", o->descriptor, "Descriptor to match by")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"moment", "voxel", "centroid-voxel"}));
+  addMaterialFlags(*app, o->material);
+  app->add_flag(
+      "--simulate", o->simulate,
+      "Simulated clock: deterministic, as fast as the machine goes, augmentation served after 20 ms "
+      "of loop time");
+  return {app, [o, app] { return runHaptic(*o, *app); }};
+}
+
+}  // namespace shapedb::cli
