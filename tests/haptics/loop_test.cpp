@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -99,6 +100,61 @@ TEST(HapticLoop, PressingSettlesWhereTheModesBalanceTheContactForce) {
     largest = std::max(largest, (deformed[i] - objects[0].mesh.vertices[i]).norm());
   EXPECT_GT(largest, 0.0);
   EXPECT_LT(largest, 0.01);
+}
+
+TEST(HapticLoop, OneTickOfContactRingsEachModeAsTheAnalyticDampedOscillator) {
+  // One tick in contact, then away: mode j was pushed by Qⱼ = φⱼᵀ(−f) for one period h and then rings
+  // freely, so qⱼ(t) = Qⱼ (s(t) − s(t − h)) with s the damped oscillator's unit step response.
+  const std::vector<SceneObject> objects = {test::boxObject("box", Vec3::Zero(), 0.1)};
+  const Vec3 touching(0.01, -0.02, 0.052), away(0.01, -0.02, 0.1);
+  struct Switchable final : ProxyDevice {
+    Vec3 at;
+    Vec3 force = Vec3::Zero();
+    Vec3 position(double) override { return at; }
+    void applyForce(double, const Vec3& f) override { force = f; }
+  } proxy;
+  proxy.at = touching;
+  LoopOptions options;
+  options.simulatedAugmentationSeconds = 0.0;
+  auto loop = HapticLoop::create(objects, proxy, synthetic(), options);
+  ASSERT_TRUE(loop.ok());
+  proxy.at = away;
+  (*loop)->tick(0.0);  // too far to touch, near enough to be augmented
+  (*loop)->simulate(0.002);
+  ASSERT_NE((*loop)->augmentation(0), nullptr);
+  ASSERT_EQ((*loop)->modalCoordinates(0).norm(), 0.0);
+
+  proxy.at = touching;
+  const Vec3 f = (*loop)->tick(1.0);
+  ASSERT_GT(f.z(), 0.0);
+  proxy.at = away;
+  const AugmentedObject& data = *(*loop)->augmentation(0);
+  const core::TetLocation where = data.locator->locate(Vec3(touching.x(), touching.y(), 0.05));
+  const Eigen::Index modes = data.physics.eigenvalues.size();
+  Eigen::VectorXd modalForce = Eigen::VectorXd::Zero(modes);
+  for (int k = 0; k < 4; ++k)
+    for (int a = 0; a < 3; ++a)
+      modalForce -= where.weights[k] *
+                    data.physics.modeShapes.row(3 * data.physics.tetMesh.tets[where.tet][k] + a).transpose() *
+                    f[a];
+  const Eigen::VectorXd zeta = data.physics.dampingRatios();
+  const double h = 1.0 / options.rateHz;
+  const auto step = [](double omega, double z, double t) {  // under-damped unit step response
+    if (t <= 0.0) return 0.0;
+    const double wd = omega * std::sqrt(1.0 - z * z);
+    return (1.0 - std::exp(-z * omega * t) * (std::cos(wd * t) + z * omega / wd * std::sin(wd * t))) /
+           (omega * omega);
+  };
+  for (int n = 1; n <= 40; ++n) {
+    if (n > 1) (*loop)->tick(1.0 + (n - 1) * h);
+    const Eigen::VectorXd q = (*loop)->modalCoordinates(0);
+    for (Eigen::Index j = 0; j < modes; ++j) {
+      const double omega = std::sqrt(data.physics.eigenvalues[j]), t = n * h;
+      const double exact = modalForce[j] * (step(omega, zeta[j], t) - step(omega, zeta[j], t - h));
+      EXPECT_NEAR(q[j], exact, 1e-9 * std::abs(modalForce[j]) / (omega * omega))
+          << "mode " << j << ", tick " << n;
+    }
+  }
 }
 
 TEST(HapticLoop, ReleasedObjectRingsDownAndComesToRest) {
