@@ -10,11 +10,16 @@
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/families.h>
 
+#include "polyhedron.h"
+
 namespace shapedb::volume {
 namespace {
 
 using core::TriangleMesh;
 using core::Vec3;
+using detail::clip;
+using detail::Polygon;
+using detail::triangulate;
 
 constexpr std::array kGenerated = {Family::kBox,     Family::kEllipsoid, Family::kCylinder, Family::kCone,
                                    Family::kCapsule, Family::kPrism,     Family::kShard};
@@ -32,74 +37,6 @@ std::array<double, 2> r2(std::uint32_t i) {
 TriangleMesh scaled(TriangleMesh mesh, const Vec3& s) {
   for (Vec3& p : mesh.vertices)
     p = p.cwiseProduct(s);
-  return mesh;
-}
-
-/// A convex polygon face of a polyhedron, counter-clockwise seen from outside.
-using Polygon = std::vector<Vec3>;
-
-/// The point where segment pq crosses the plane n·x = d, computed from the endpoints in a fixed order,
-/// so the two faces sharing the edge get the same bits.
-Vec3 crossing(Vec3 p, Vec3 q, const Vec3& n, double d) {
-  if (std::lexicographical_compare(q.data(), q.data() + 3, p.data(), p.data() + 3)) std::swap(p, q);
-  const double dp = n.dot(p) - d, dq = n.dot(q) - d;
-  return p + (dp / (dp - dq)) * (q - p);
-}
-
-/// Cuts a convex polyhedron by the half-space n·x ≤ d, closing the cut with a new face.
-std::vector<Polygon> clip(const std::vector<Polygon>& faces, const Vec3& n, double d) {
-  std::vector<Polygon> result;
-  std::vector<Vec3> cut;
-  for (const Polygon& face : faces) {
-    Polygon kept;
-    for (std::size_t i = 0; i < face.size(); ++i) {
-      const Vec3& p = face[i];
-      const Vec3& q = face[(i + 1) % face.size()];
-      const bool pIn = n.dot(p) <= d, qIn = n.dot(q) <= d;
-      if (pIn) kept.push_back(p);
-      if (pIn != qIn) {
-        kept.push_back(crossing(p, q, n, d));
-        cut.push_back(kept.back());
-      }
-    }
-    if (kept.size() >= 3) result.push_back(std::move(kept));
-  }
-  if (cut.size() >= 3) {
-    // The cap: the cut points ordered counter-clockwise about n (outward for the kept side).
-    Vec3 center = Vec3::Zero();
-    for (const Vec3& p : cut)
-      center += p;
-    center /= static_cast<double>(cut.size());
-    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
-    std::sort(cut.begin(), cut.end(), [&](const Vec3& a, const Vec3& b) {
-      return std::atan2((a - center).dot(v), (a - center).dot(u)) <
-             std::atan2((b - center).dot(v), (b - center).dot(u));
-    });
-    cut.erase(std::unique(cut.begin(), cut.end()), cut.end());
-    if (cut.size() >= 3) result.push_back(cut);
-  }
-  return result;
-}
-
-/// Polygons → triangle mesh with shared vertices (welded on a 2⁻³⁰ lattice) and fan triangles.
-TriangleMesh triangulate(const std::vector<Polygon>& faces) {
-  TriangleMesh mesh;
-  std::map<std::array<double, 3>, std::uint32_t> ids;
-  const auto id = [&](const Vec3& p) {
-    const double q = std::ldexp(1.0, 30);
-    const std::array<double, 3> key = {std::round(p.x() * q) / q, std::round(p.y() * q) / q,
-                                       std::round(p.z() * q) / q};
-    auto [it, inserted] = ids.try_emplace(key, static_cast<std::uint32_t>(mesh.vertices.size()));
-    if (inserted) mesh.vertices.emplace_back(key[0], key[1], key[2]);
-    return it->second;
-  };
-  for (const Polygon& face : faces) {
-    std::vector<std::uint32_t> v;
-    for (const Vec3& p : face)
-      if (const std::uint32_t i = id(p); v.empty() || (i != v.back() && i != v.front())) v.push_back(i);
-    for (std::size_t i = 1; i + 1 < v.size(); ++i)
-      mesh.triangles.push_back({v[0], v[i], v[i + 1]});
-  }
   return mesh;
 }
 

@@ -1,0 +1,36 @@
+#pragma once
+
+// Procedural fracture (the paper's main scenario, Figures 1, 8, 9): a closed surface broken into
+// fragments with OpenVDB level sets. The solid becomes a narrow-band level set; random seed points inside
+// it define Voronoi cells, each cell becomes a level-set cutter, and tools::LevelSetFracture cuts the
+// solid by one cutter after the other (pieces a cell splits in two, on a non-convex solid, become separate
+// fragments). Each fragment is meshed back at its zero crossing.
+
+#include <cstdint>
+#include <vector>
+
+#include <shapedb/core/result.h>
+#include <shapedb/core/triangle_mesh.h>
+
+namespace shapedb::volume {
+
+struct FractureOptions {
+  int pieces = 20;         ///< Voronoi seeds (≥ 1, ≤ 10,000); the fragment count can differ (see below)
+  std::uint64_t seed = 1;  ///< the same seed and mesh give the same fragments, to the bit
+  int resolution = 128;    ///< voxels along the mesh's longest side (16 to 1,024)
+  /// Fragments smaller than this fraction of the solid's volume (voxel-scale crumbs) are dropped.
+  double minVolumeFraction = 1e-4;
+};
+
+struct FractureResult {
+  std::vector<core::TriangleMesh> fragments;  ///< closed, outward-oriented, in the mesh's frame; by size
+  double voxelSize = 0.0;                     ///< the level sets' resolution (m): the fragments' detail
+  std::size_t crumbsDropped = 0;              ///< fragments under minVolumeFraction
+  std::size_t openDropped = 0;                ///< fragments whose meshing did not close (should be none)
+};
+
+/// Errors: kInvalidArgument for options out of range; validateMesh's; kNotClosed (and the other
+/// topology errors) for a mesh that does not enclose a volume.
+Result<FractureResult> fracture(const core::TriangleMesh& mesh, const FractureOptions& options = {});
+
+}  // namespace shapedb::volume
