@@ -6,6 +6,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <shapedb/core/result.h>
+#include <shapedb/volume/fracture.h>
+
 namespace shapedb::cli {
 
 /// Exit codes shared by every subcommand.
@@ -29,6 +32,13 @@ Command addInfoCommand(CLI::App& parent);
 Command addAddCommand(CLI::App& parent);
 Command addQueryCommand(CLI::App& parent);
 Command addHapticCommand(CLI::App& parent);
+Command addFractureCommand(CLI::App& parent);
+
+/// Loads a mesh file and fractures it; errors name the file. Shared by fracture and haptic --fracture.
+Result<volume::FractureResult> fractureMeshFile(const std::string& path,
+                                                const volume::FractureOptions& options);
+/// Adds --seed and --resolution for `options`.
+void addFractureFlags(CLI::App& app, volume::FractureOptions& options);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);

@@ -24,6 +24,8 @@ namespace {
 struct HapticCommandOptions {
   std::string database;
   std::string scene;
+  std::string fractureMesh;
+  volume::FractureOptions fracture;
   std::string trajectory;
   std::string report;
   std::string descriptor = "centroid-voxel";
@@ -65,7 +67,7 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
     objects.push_back(std::move(j));
   }
   return {{"database", o.database},
-          {"scene", o.scene},
+          {"scene", o.scene.empty() ? o.fractureMesh : o.scene},
           {"clock", o.simulate ? "simulated" : "steady"},
           {"rate_hz", o.loop.rateHz},
           {"seconds", r.seconds},
@@ -115,7 +117,24 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
 
-  auto scene = haptics::loadScene(o.scene);
+  if (o.scene.empty() == o.fractureMesh.empty()) {
+    printError("give a SCENE_DIR or --fracture MESH --pieces N, not both");
+    return kExitUsage;
+  }
+  Result<std::vector<haptics::SceneObject>> scene = std::vector<haptics::SceneObject>{};
+  if (!o.scene.empty()) {
+    scene = haptics::loadScene(o.scene);
+  } else {
+    // The fragments stay where the fracture left them: the broken object, in its own frame.
+    Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.fracture);
+    if (!pieces) {
+      scene = pieces.error();
+    } else {
+      for (std::size_t i = 0; i < pieces->fragments.size(); ++i)
+        scene->push_back({"fragment-" + std::to_string(i), std::move(pieces->fragments[i])});
+      std::fprintf(stderr, "haptic: %s broken into %zu fragments\n", o.fractureMesh.c_str(), scene->size());
+    }
+  }
   if (!scene) {
     printError(scene.error().message);
     return kExitInputError;
@@ -181,19 +200,27 @@ Command addHapticCommand(CLI::App& parent) {
   auto o = std::make_shared<HapticCommandOptions>();
   CLI::App* app = parent.add_subcommand(
       "haptic",
-      "Run the fixed-rate haptic loop over a scene of surface meshes: a proxy sphere moves through the "
-      "scene\n"
-      "(a CSV trajectory, or by default a sweep through it); objects it comes near are given physical data\n"
-      "from the database by worker threads (query, adapt, link) while the loop keeps its rate; objects it\n"
-      "touches push back through their collision compound and vibrate through their modes. Writes a JSON\n"
-      "report: achieved rate, tick time percentiles, deadline misses, augmentation latency, per-object\n"
-      "outcome. Objects that cannot be augmented (say, open meshes) are reported, not fatal.");
+      "Run the fixed-rate haptic loop over a scene of surface meshes (a directory, or the fragments of a\n"
+      "mesh broken with --fracture): a proxy sphere moves through the scene (a CSV trajectory, or by\n"
+      "default a sweep through it); objects it comes near are given physical data from the database by\n"
+      "worker threads (query, adapt, link) while the loop keeps its rate; objects it touches push back\n"
+      "through their collision compound and vibrate through their modes. Writes a JSON report: achieved\n"
+      "rate, tick time percentiles, deadline misses, augmentation latency, per-object outcome. Objects that\n"
+      "cannot be augmented (say, open meshes) are reported, not fatal.");
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
   app->add_option(
-         "SCENE_DIR", o->scene,
-         "Directory of surface meshes (.obj, .ply, .off, .stl), each an object in world coordinates, "
-         "metres")
-      ->required();
+      "SCENE_DIR", o->scene,
+      "Directory of surface meshes (.obj, .ply, .off, .stl), each an object in world coordinates, "
+      "metres");
+  CLI::Option* fractureOption = app->add_option(
+      "--fracture", o->fractureMesh,
+      "Instead of SCENE_DIR: break this closed mesh into fragments (as shapedb fracture) and use "
+      "them, in place, as the scene");
+  app->add_option("--pieces", o->fracture.pieces, "With --fracture: Voronoi seeds")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000))
+      ->needs(fractureOption);
+  addFractureFlags(*app, o->fracture);
   app->add_option("--report", o->report, "JSON report file")->required();
   app->add_option("--rate", o->loop.rateHz, "Loop rate, Hz")
       ->capture_default_str()

@@ -2,6 +2,9 @@
 // files and a CSV trajectory; its JSON report parsed back.
 
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -94,6 +97,67 @@ TEST(HapticCli, ReportParsedBackForASceneWithAnOpenMesh) {
     accounted += s[key].get<int>();
   EXPECT_LE(accounted, 3);
   EXPECT_TRUE(s["augmentation_latency_ms"].contains("p99"));
+}
+
+std::string readAll(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoop) {
+  test::ScratchDir dir("fracture-cli");
+  const auto plate = dir / "plate.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeBox({0.4, 0.3, 0.02}), plate).ok());
+  const auto out = dir / "pieces", again = dir / "again";
+  for (const auto& target : {out, again}) {
+    test::ProcessResult r =
+        test::runProcess(SHAPEDB_CLI, {"fracture", plate.string(), "--pieces", "6", "--seed", "3",
+                                       "--resolution", "48", "--out", target.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("fragments from 6 seeds"), std::string::npos) << r.out;
+  }
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    files.push_back(entry.path());
+  ASSERT_GE(files.size(), 4u);
+  for (const auto& file : files) {
+    auto mesh = io::loadMesh(file);
+    ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+    EXPECT_TRUE(mesh->topology.isClosed()) << file;
+    EXPECT_EQ(readAll(file), readAll(again / file.filename())) << file.filename();
+  }
+
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "8", "--families", "shard,box",
+                                           "--modes", "4", "--quiet"})
+                .exitCode,
+            0);
+  const auto report = dir / "report.json";
+  test::ProcessResult run =
+      test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), "--fracture", plate.string(), "--pieces", "6",
+                                     "--seed", "3", "--resolution", "48", "--simulate", "--seconds", "4",
+                                     "--speed", "0.3", "--report", report.string()});
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  const nlohmann::json r = readJson(report);
+  EXPECT_EQ(r["scene"], plate.string());
+  EXPECT_EQ(r["objects"].size(), files.size());  // the same fragments as shapedb fracture wrote
+  EXPECT_GT(r["objects_augmented"].get<int>(), 0);
+  EXPECT_EQ(r["objects_failed"], 0);
+  EXPECT_GT(r["contact_ticks"].get<int>(), 0);
+
+  test::ProcessResult both = test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), out.string(), "--fracture",
+                                                            plate.string(), "--report", report.string()});
+  EXPECT_EQ(both.exitCode, 2);
+  EXPECT_NE(both.err.find("not both"), std::string::npos) << both.err;
+  test::ProcessResult pieces = test::runProcess(
+      SHAPEDB_CLI, {"haptic", db.string(), out.string(), "--pieces", "4", "--report", report.string()});
+  EXPECT_EQ(pieces.exitCode, 2);
+  const auto openPath = dir / "open.obj";
+  std::ofstream(openPath) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n";
+  test::ProcessResult open = test::runProcess(
+      SHAPEDB_CLI, {"fracture", openPath.string(), "--pieces", "3", "--out", (dir / "x").string()});
+  EXPECT_EQ(open.exitCode, 1);
+  EXPECT_NE(open.err.find("open.obj: mesh is not closed"), std::string::npos) << open.err;
 }
 
 TEST(HapticCli, BadInputsAreClearErrors) {
