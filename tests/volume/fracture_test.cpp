@@ -101,5 +101,25 @@ TEST(Fracture, OnePieceIsTheWholeSolid) {
   EXPECT_NEAR(volumeOf(r->fragments[0]) / volumeOf(sphere), 1.0, 0.03);
 }
 
+TEST(Fracture, ACellThatHoldsTwoSeparatePartsGivesTwoFragments) {
+  // Two boxes apart, one mesh: the single cell covers both, and segmentation must split them.
+  core::TriangleMesh pair = core::makeBox({0.2, 0.2, 0.2});
+  const core::TriangleMesh other = core::makeBox({0.1, 0.1, 0.1});
+  const auto offset = static_cast<std::uint32_t>(pair.vertices.size());
+  for (const core::Vec3& p : other.vertices)
+    pair.vertices.push_back(p + core::Vec3(0.5, 0.0, 0.0));
+  for (const auto& t : other.triangles)
+    pair.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  FractureOptions options;
+  options.pieces = 1;
+  options.resolution = 96;
+  const Result<FractureResult> r = fracture(pair, options);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_EQ(r->fragments.size(), 2u);
+  EXPECT_NEAR(volumeOf(r->fragments[0]), 0.008, 0.0008);  // largest first
+  EXPECT_NEAR(volumeOf(r->fragments[1]), 0.001, 0.0002);
+  EXPECT_GT(core::computeBounds(r->fragments[1]).min.x(), 0.3);
+}
+
 }  // namespace
 }  // namespace shapedb::volume

@@ -2,9 +2,9 @@
 
 // Procedural fracture (the paper's main scenario, Figures 1, 8, 9): a closed surface broken into
 // fragments with OpenVDB level sets. The solid becomes a narrow-band level set; random seed points inside
-// it define Voronoi cells, each cell becomes a level-set cutter, and tools::LevelSetFracture cuts the
-// solid by one cutter after the other (pieces a cell splits in two, on a non-convex solid, become separate
-// fragments). Each fragment is meshed back at its zero crossing.
+// it define Voronoi cells, each cell becomes a level-set cutter intersected with the solid (the CSG and
+// segmentation of tools::LevelSetFracture, cell by cell and in parallel; pieces a cell splits in two, on a
+// non-convex solid, become separate fragments). Each fragment is meshed back at its zero crossing.
 
 #include <cstdint>
 #include <vector>
@@ -15,7 +15,7 @@
 namespace shapedb::volume {
 
 struct FractureOptions {
-  int pieces = 20;         ///< Voronoi seeds (≥ 1, ≤ 10,000); the fragment count can differ (see below)
+  int pieces = 20;         ///< Voronoi seeds (1 to 1,000); the fragment count can differ (see below)
   std::uint64_t seed = 1;  ///< the same seed and mesh give the same fragments, to the bit
   int resolution = 128;    ///< voxels along the mesh's longest side (16 to 1,024)
   /// Fragments smaller than this fraction of the solid's volume (voxel-scale crumbs) are dropped.
