@@ -6,6 +6,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/fracture.h>
+#include <shapedb/volume/tetrahedralize.h>
 
 namespace shapedb::volume {
 namespace {
@@ -99,6 +100,31 @@ TEST(Fracture, OnePieceIsTheWholeSolid) {
   ASSERT_TRUE(r.ok());
   ASSERT_EQ(r->fragments.size(), 1u);
   EXPECT_NEAR(volumeOf(r->fragments[0]) / volumeOf(sphere), 1.0, 0.03);
+}
+
+TEST(Fracture, FragmentsAreSimplifiedAndTetGenFillsThemExactly) {
+  // The raw level-set meshes hold edges a thousandth of a voxel long, on which TetGen failed or merged
+  // nearly coplanar facets (moving the surface); simplified fragments mesh, and their tets fill them.
+  FractureOptions options;
+  options.pieces = 4;
+  options.seed = 3;
+  options.resolution = 64;
+  options.maxTriangles = 1500;
+  const Result<FractureResult> r = fracture(core::makeIcosphere(0.1, 4), options);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_GE(r->fragments.size(), 3u);
+  for (const core::TriangleMesh& piece : r->fragments) {
+    EXPECT_LE(piece.triangles.size(), 1500u);
+    TetrahedralizeOptions tetgen;
+    tetgen.maxVolumeFraction = 1.0 / 200.0;
+    const Result<core::TetMesh> tets = tetrahedralize(piece, tetgen);
+    ASSERT_TRUE(tets.ok()) << tets.error().message;
+    EXPECT_NEAR(core::computeTetMassProperties(*tets).volume / volumeOf(piece), 1.0, 1e-9);
+  }
+  options.maxTriangles = 0;  // the raw meshes: many more triangles
+  const Result<FractureResult> raw = fracture(core::makeIcosphere(0.1, 4), options);
+  ASSERT_TRUE(raw.ok());
+  EXPECT_GT(raw->fragments.front().triangles.size(), 3000u);
 }
 
 TEST(Fracture, ACellThatHoldsTwoSeparatePartsGivesTwoFragments) {

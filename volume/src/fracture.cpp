@@ -16,6 +16,7 @@
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/fracture.h>
 #include <shapedb/volume/openvdb_runtime.h>
+#include <shapedb/volume/simplify.h>
 
 #include "polyhedron.h"
 
@@ -79,6 +80,10 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   if (options.resolution < 16 || options.resolution > 1024)
     return Error{ErrorCode::kInvalidArgument,
                  "resolution must be 16 to 1,024 voxels, not " + std::to_string(options.resolution)};
+  if (options.maxTriangles != 0 && (options.maxTriangles < 100 || !(options.simplifyError > 0.0)))
+    return Error{ErrorCode::kInvalidArgument,
+                 "fragments simplified to fewer than 100 triangles, or with no error allowed, would not "
+                 "be fragments (0 keeps the raw meshes)"};
   if (!(options.minVolumeFraction >= 0.0 && options.minVolumeFraction < 1.0))
     return Error{ErrorCode::kInvalidArgument, "the crumb threshold must be a fraction in [0, 1)"};
   if (Status st = core::validateMesh(mesh); !st) return st.error();
@@ -148,8 +153,17 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   for (auto& g : cellGrids)
     grids.insert(grids.end(), g.begin(), g.end());
 
+  // Meshed, and simplified where the raw mesh is closed (an open one is dropped below either way).
   std::vector<TriangleMesh> meshes(grids.size());
-  tbb::parallel_for(std::size_t{0}, grids.size(), [&](std::size_t i) { meshes[i] = meshOf(*grids[i]); });
+  tbb::parallel_for(std::size_t{0}, grids.size(), [&](std::size_t i) {
+    meshes[i] = meshOf(*grids[i]);
+    if (options.maxTriangles == 0 || meshes[i].triangles.size() <= options.maxTriangles) return;
+    SimplifyOptions simplifyOptions;
+    simplifyOptions.maxTriangles = options.maxTriangles;
+    simplifyOptions.maxError = options.simplifyError * result.voxelSize;
+    if (Result<TriangleMesh> simpler = simplify(meshes[i], simplifyOptions); simpler.ok())
+      meshes[i] = std::move(simpler).value();
+  });
 
   std::vector<std::pair<double, TriangleMesh>> pieces;
   for (TriangleMesh& piece : meshes) {

@@ -263,9 +263,9 @@ std::string describeTetGenError(int code) {
 
 }  // namespace
 
-std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume) {
-  // p: the input is a piecewise linear complex; q: quality bound; a: volume bound; Q: quiet;
-  // z: number from zero.
+std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, bool mergeFacets) {
+  // p: the input is a piecewise linear complex; q: quality bound; a: volume bound; M: no merging of
+  // coplanar facets; Q: quiet; z: number from zero.
   char buffer[96];
   std::string switches = "p";
   if (options.maxRadiusEdgeRatio > 0.0) {
@@ -276,15 +276,18 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume) 
     std::snprintf(buffer, sizeof buffer, "a%.6g", options.maxVolumeFraction * volume);
     switches += buffer;
   }
-  return switches + "Qz";
+  return switches + (mergeFacets ? "Qz" : "MQz");
 }
 
 namespace {
 
-/// One TetGen run with these switches, its output checked and turned positive.
+/// One TetGen run with these switches, its output checked and turned positive, and checked to fill the
+/// surface: same volume and centroid to 1e-9 (relative). `moved` says when that last check failed.
 Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const TetrahedralizeOptions& options,
-                                   double volume) {
-  const std::string switches = tetgenSwitches(options, volume);
+                                   const core::MassProperties& mass, bool mergeFacets, bool& moved) {
+  moved = false;
+  const double volume = mass.volume;
+  const std::string switches = tetgenSwitches(options, volume, mergeFacets);
   RawResult raw;
   if (options.guarded) {
     auto guarded = runTetGenGuarded(surface, switches, options.timeoutSeconds);
@@ -312,6 +315,13 @@ Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const Tetrahedra
   }
   if (Status valid = core::validateTetMesh(mesh); !valid)
     return Error{ErrorCode::kParse, "TetGen returned an invalid mesh: " + valid.error().message};
+  const core::MassProperties filled = core::computeTetMassProperties(mesh);
+  if (std::abs(filled.volume - volume) > 1e-9 * volume ||
+      (filled.centerOfMass - mass.centerOfMass).norm() > 1e-9 * std::cbrt(volume)) {
+    moved = true;
+    return Error{ErrorCode::kParse, "TetGen moved the surface: its tets hold " +
+                                        std::to_string(filled.volume / volume) + " of the volume"};
+  }
   return mesh;
 }
 
@@ -327,12 +337,24 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   auto mass = core::computeMassProperties(surface);
   if (!mass) return mass.error();
 
-  Result<TetMesh> tets = tetrahedralizeOnce(surface, options, mass->volume);
+  // TetGen merges adjacent facets it finds nearly coplanar, which moves a surface whose facets are only
+  // nearly so (a simplified level-set mesh: the volume changed by 1e-6), or aborts on it. Such a run is
+  // repeated without merging ('M'); not always: TetGen 1.5 aborts with 'M' on some exactly coplanar
+  // input (a box).
+  auto attempt = [&](const TetrahedralizeOptions& o) {
+    bool moved = false;
+    Result<TetMesh> result = tetrahedralizeOnce(surface, o, *mass, /*mergeFacets=*/true, moved);
+    if (!result) {
+      Result<TetMesh> unmerged = tetrahedralizeOnce(surface, o, *mass, /*mergeFacets=*/false, moved);
+      if (unmerged) result = std::move(unmerged);
+    }
+    return result;
+  };
+  Result<TetMesh> tets = attempt(options);
   if (!options.relaxOnFailure) return tets;
   // The guarded worker died or hung: the same request once more in a fresh worker first, so that a broken
   // worker (rather than TetGen's answer) never changes the mesh.
-  if (!tets && tets.error().code == ErrorCode::kIo && options.guarded)
-    tets = tetrahedralizeOnce(surface, options, mass->volume);
+  if (!tets && tets.error().code == ErrorCode::kIo && options.guarded) tets = attempt(options);
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
   // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
   for (double relaxed : {2.5, 0.0}) {
@@ -341,7 +363,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     TetrahedralizeOptions looser = options;
     looser.maxRadiusEdgeRatio = relaxed;
     looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
-    tets = tetrahedralizeOnce(surface, looser, mass->volume);
+    tets = attempt(looser);
   }
   return tets;
 }

@@ -4,8 +4,10 @@
 // fragments with OpenVDB level sets. The solid becomes a narrow-band level set; random seed points inside
 // it define Voronoi cells, each cell becomes a level-set cutter intersected with the solid (the CSG and
 // segmentation of tools::LevelSetFracture, cell by cell and in parallel; pieces a cell splits in two, on a
-// non-convex solid, become separate fragments). Each fragment is meshed back at its zero crossing.
+// non-convex solid, become separate fragments). Each fragment is meshed back at its zero crossing and
+// simplified to what physics needs.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -20,6 +22,12 @@ struct FractureOptions {
   int resolution = 128;    ///< voxels along the mesh's longest side (16 to 1,024)
   /// Fragments smaller than this fraction of the solid's volume (voxel-scale crumbs) are dropped.
   double minVolumeFraction = 1e-4;
+  /// Each fragment's mesh is simplified to at most this many triangles (volume::simplify), moving its
+  /// surface by at most simplifyError voxels; 0 keeps the raw level-set mesh, which holds tens of
+  /// thousands of triangles and edges a thousandth of a voxel long (TetGen refines such a mesh into
+  /// hundreds of thousands of tets, or fails on it).
+  std::size_t maxTriangles = 3000;
+  double simplifyError = 0.25;
 };
 
 struct FractureResult {

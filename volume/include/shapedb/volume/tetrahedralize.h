@@ -28,13 +28,15 @@ struct TetrahedralizeOptions {
   bool relaxOnFailure = true;
 };
 
-/// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like.
-std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume);
+/// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like; with "M" when `mergeFacets` is
+/// off (see tetrahedralize).
+std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, bool mergeFacets = true);
 
 /// A quality tetrahedral mesh of the solid bounded by `surface` (TetGen: a constrained Delaunay
 /// tetrahedralization of the surface as a piecewise linear complex, refined to the quality bounds). The
 /// tets fill the surface exactly: their boundary lies on the input faces, so their volume integrals
-/// equal the surface integrals to round-off.
+/// equal the surface integrals to round-off; a run whose tets do not (volume or centroid off by more than
+/// 1e-9: TetGen merged nearly coplanar facets) is repeated with merging off.
 ///
 /// The input is validated first (finite, indices in range, no degenerate face, closed, consistently and
 /// outward oriented, positive volume): TetGen is never handed a mesh it is known to choke on. Errors: the
