@@ -1,7 +1,11 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include <shapedb/core/fidelity.h>
 
@@ -74,6 +78,98 @@ Fidelity assessFidelity(const TriangleMesh& query, const ClosestPointTree& query
   f.meanDeviation = n > 0 ? sum / n : 0.0;
   f.maxDeviation = worst;
   return f;
+}
+
+VolumeOverlap sampleOverlap(const SampledSolid& a, const SampledSolid& b, int resolution) {
+  resolution = std::clamp(resolution, 8, 512);
+  const Vec3 lo = a.bounds.min.cwiseMin(b.bounds.min);
+  const Vec3 extent = a.bounds.max.cwiseMax(b.bounds.max) - lo;
+  const double cell = extent.maxCoeff() / resolution;
+  VolumeOverlap overlap;
+  if (!(cell > 0.0) || !std::isfinite(cell)) return overlap;
+  Eigen::Array3i n;
+  for (int k = 0; k < 3; ++k)
+    n[k] = std::max(1, static_cast<int>(std::ceil(extent[k] / cell - 1e-9)));
+  // Counts per slice: inside A, inside B, inside both.
+  using Counts = std::array<long, 3>;
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, n[2]), Counts{},
+      [&](const tbb::blocked_range<int>& slices, Counts c) {
+        for (int z = slices.begin(); z != slices.end(); ++z)
+          for (int y = 0; y < n[1]; ++y)
+            for (int x = 0; x < n[0]; ++x) {
+              const Vec3 p = lo + cell * Vec3(x + 0.5, y + 0.5, z + 0.5);
+              const bool inA = a.contains(p), inB = b.contains(p);
+              c[0] += inA;
+              c[1] += inB;
+              c[2] += inA && inB;
+            }
+        return c;
+      },
+      [](const Counts& l, const Counts& r) {
+        return Counts{l[0] + r[0], l[1] + r[1], l[2] + r[2]};
+      });
+  const double voxel = cell * cell * cell;
+  overlap.samples = static_cast<long>(n.prod());
+  overlap.volumeA = counts[0] * voxel;
+  overlap.volumeB = counts[1] * voxel;
+  const long unionCount = counts[0] + counts[1] - counts[2];
+  overlap.iou = unionCount > 0 ? static_cast<double>(counts[2]) / unionCount : 0.0;
+  if (counts[0] > 0) {
+    overlap.coverage = static_cast<double>(counts[2]) / counts[0];
+    overlap.overshoot = static_cast<double>(counts[1] - counts[2]) / counts[0];
+  }
+  return overlap;
+}
+
+Bounds compoundBounds(const CollisionCompound& compound) {
+  Bounds box{Vec3::Constant(std::numeric_limits<double>::infinity()),
+             Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  for (const CollisionShape& shape : compound.shapes) {
+    Vec3 half = Vec3::Zero();
+    switch (shape.type) {
+      case CollisionShape::Type::kSphere:
+        half = Vec3::Constant(shape.radius);
+        break;
+      case CollisionShape::Type::kBox:
+        half = shape.rotation.cwiseAbs() * shape.halfExtents;
+        break;
+      case CollisionShape::Type::kCapsule:
+        half = shape.rotation.col(2).cwiseAbs() * shape.halfLength + Vec3::Constant(shape.radius);
+        break;
+    }
+    box.min = box.min.cwiseMin(shape.center - half);
+    box.max = box.max.cwiseMax(shape.center + half);
+  }
+  if (compound.shapes.empty()) box = Bounds{};
+  return box;
+}
+
+SampledSolid sampledSolid(const CollisionCompound& compound) {
+  return {[&compound](const Vec3& p) {
+            return std::any_of(compound.shapes.begin(), compound.shapes.end(),
+                               [&](const CollisionShape& shape) { return shape.contains(p); });
+          },
+          compoundBounds(compound)};
+}
+
+namespace {
+Vec3 equivalentHalfAxes(const Vec3& moments, double mass, double k) {
+  Vec3 axes;
+  for (int i = 0; i < 3; ++i) {
+    const double sum = moments[(i + 1) % 3] + moments[(i + 2) % 3] - moments[i];
+    axes[i] = std::sqrt(std::max(0.0, k * sum / (2.0 * mass)));
+  }
+  return axes;
+}
+}  // namespace
+
+Vec3 inertiaEquivalentEllipsoid(const Vec3& principalMoments, double mass) {
+  return equivalentHalfAxes(principalMoments, mass, 5.0);
+}
+
+Vec3 inertiaEquivalentBox(const Vec3& principalMoments, double mass) {
+  return equivalentHalfAxes(principalMoments, mass, 3.0);
 }
 
 }  // namespace shapedb::core
