@@ -1,5 +1,3 @@
-#include <algorithm>
-#include <cctype>
 #include <string>
 #include <system_error>
 
@@ -14,24 +12,12 @@ Result<std::vector<SceneObject>> loadScene(const fs::path& directory) {
   std::error_code ec;
   if (!fs::is_directory(directory, ec))
     return Error{ErrorCode::kIo, directory.string() + ": not a directory (a scene is a directory of meshes)"};
-  std::vector<fs::path> files;
-  for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
-    std::string extension = entry.path().extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (entry.is_regular_file() &&
-        (extension == ".obj" || extension == ".ply" || extension == ".off" || extension == ".stl"))
-      files.push_back(entry.path());
-  }
-  if (ec) return Error{ErrorCode::kIo, directory.string() + ": " + ec.message()};
-  if (files.empty())
-    return Error{ErrorCode::kIo,
-                 directory.string() + ": no mesh files (.obj, .ply, .off, .stl) in the scene"};
-  std::sort(files.begin(), files.end());
+  Result<std::vector<fs::path>> files = io::listMeshFiles(directory);
+  if (!files) return files.error();
 
   std::vector<SceneObject> objects;
-  objects.reserve(files.size());
-  for (const fs::path& file : files) {
+  objects.reserve(files->size());
+  for (const fs::path& file : *files) {
     Result<io::LoadedMesh> loaded = io::loadMesh(file);
     if (!loaded) return loaded.error();  // names the file
     objects.push_back({file.filename().string(), std::move(loaded->mesh)});

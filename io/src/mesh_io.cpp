@@ -140,6 +140,27 @@ using WritableMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
 
 }  // namespace
 
+Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::path& directory) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec))
+    return Error{ErrorCode::kIo, directory.string() + ": not a directory"};
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+    std::string extension = entry.path().extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (entry.is_regular_file() &&
+        (extension == ".obj" || extension == ".ply" || extension == ".off" || extension == ".stl"))
+      files.push_back(entry.path());
+  }
+  if (ec) return Error{ErrorCode::kIo, directory.string() + ": " + ec.message()};
+  if (files.empty())
+    return Error{ErrorCode::kIo, directory.string() + ": no mesh files (.obj, .ply, .off, .stl)"};
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options) {
   // Format by extension, then the file itself.
   const std::string format = lowercaseExtension(path);

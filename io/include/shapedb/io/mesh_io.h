@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <shapedb/core/result.h>
 #include <shapedb/core/topology.h>
@@ -33,6 +34,10 @@ struct LoadedMesh {
 /// "part.stl: truncated binary STL (header says 12 triangles, file holds 3)". Errors: kIo, kUnknownFormat,
 /// kParse, kEmptyMesh, kNonFinite, kIndexOutOfRange, kDegenerateFace. Thread-safe.
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options = {});
+
+/// The mesh files (.obj, .ply, .off, .stl, any case) directly in `directory`, sorted by name.
+/// Errors: kIo (not a directory, unreadable, or no mesh file in it), naming the directory.
+Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::path& directory);
 
 /// What saveMesh writes.
 struct SaveOptions {
