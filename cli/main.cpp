@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
                                    addInfoCommand(app),    addAddCommand(app),      addQueryCommand(app),
-                                   addHapticCommand(app),  addFractureCommand(app)};
+                                   addHapticCommand(app),  addFractureCommand(app), addBenchCommand(app)};
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,113 @@
+#pragma once
+// The physical-fidelity benchmark (the measurement the paper leaves as future work, §7): for each query
+// shape, the data each descriptor retrieves and adapts, and the data of two simple alternatives, against
+// the data computed directly on the shape (TetGen + FEM + modes, the database's own pipeline and
+// parameters). Errors are in the quantities a simulation uses: the first non-rigid frequencies and the
+// volume of the collision proxy.
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include <shapedb/core/adapt.h>
+#include <shapedb/core/fidelity.h>
+#include <shapedb/core/result.h>
+#include <shapedb/io/database.h>
+
+namespace shapedb::io {
+
+/// What supplies a shape's physical data: the top-1 match of each descriptor, adapted (the method), or
+/// the inertia-equivalent solid ellipsoid (the precomputed sound banks of Zheng & James 2010, at their
+/// best: the exact ellipsoid rather than the nearest precomputed one) or box.
+enum class EvaluationMethod { kMoment, kVoxel, kCentroidVoxel, kEllipsoid, kBox };
+inline constexpr std::array<EvaluationMethod, 5> kEvaluationMethods{
+    EvaluationMethod::kMoment, EvaluationMethod::kVoxel, EvaluationMethod::kCentroidVoxel,
+    EvaluationMethod::kEllipsoid, EvaluationMethod::kBox};
+/// "moment", "voxel", "centroid-voxel", "ellipsoid", "box".
+const char* toString(EvaluationMethod method);
+
+struct MethodEvaluation {
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  EvaluationMethod method = EvaluationMethod::kCentroidVoxel;
+  std::string match;              ///< the matched entry's name (descriptors); "" for the baselines
+  std::string family;             ///< the matched entry's family (descriptors); "" for the baselines
+  double distance = kNaN;         ///< descriptor distance (descriptors)
+  Eigen::VectorXd frequenciesHz;  ///< the first non-rigid frequencies, in the material
+  /// Relative frequency errors against the direct computation, (f − f*) / f*: the first (signed), the
+  /// mean and the max of |·| over the first EvaluationOptions::frequencies.
+  double firstFrequencyError = kNaN;
+  double meanFrequencyError = kNaN;
+  double maxFrequencyError = kNaN;
+  /// The collision proxy (the adapted compound; the baselines' own solid) against the shape's volume.
+  core::VolumeOverlap overlap;
+  double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, adapt, link)
+  double matchMicros = kNaN;  ///< descriptors: validate, mass properties, describe, search
+};
+
+struct FragmentEvaluation {
+  std::string name;
+  std::size_t triangles = 0;
+  double volume = 0.0;  ///< m³
+  /// Empty when every method was evaluated; else why not (the shape was refused, TetGen failed on it):
+  /// the fields below are then whatever was reached.
+  std::string error;
+  Eigen::VectorXd truthFrequenciesHz;  ///< computed directly on the shape
+  double truthSeconds = 0.0;           ///< tetrahedralize + modes + collision compound, wall time
+  std::size_t truthTets = 0;
+  std::vector<MethodEvaluation> methods;  ///< kEvaluationMethods' order
+  /// Direct computation over the centroid-voxel query's time: what the database saves.
+  double speedup() const;
+  bool ok() const { return error.empty(); }
+};
+
+struct EvaluationOptions {
+  core::Material material = core::materialPresets()[0];  ///< steel
+  int frequencies = 5;         ///< non-rigid frequencies compared (at most the database's modes)
+  int overlapResolution = 48;  ///< sampling grid of the volume overlap, cells along the longest side
+  int threads = 0;             ///< for the direct computations; 0: all cores
+  /// Called after each shape's direct computation, from one thread at a time: done, total, its name.
+  std::function<void(std::size_t, std::size_t, const std::string&)> progress;
+};
+
+/// Evaluates every shape (closed meshes, any frame): first the queries, one at a time so that their
+/// timings are those of an idle machine; then the direct computations and the baselines in parallel.
+/// A shape that fails is reported in its FragmentEvaluation, and the others go on.
+/// Errors: kInvalidArgument for options out of range or a material validateMaterial refuses.
+Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
+                                                       std::span<const NamedMesh> shapes,
+                                                       const EvaluationOptions& options = {});
+
+/// Summary statistics of one method over the shapes that were evaluated.
+struct MethodSummary {
+  EvaluationMethod method = EvaluationMethod::kCentroidVoxel;
+  std::size_t count = 0;
+  double medianFirstError = 0.0;  ///< median of |first frequency error|
+  double medianMeanError = 0.0;   ///< median of the mean error over the first frequencies
+  double p90FirstError = 0.0;
+  double medianIou = 0.0;
+  double medianQueryMicros = MethodEvaluation::kNaN;  ///< descriptors
+};
+std::vector<MethodSummary> summarize(std::span<const FragmentEvaluation> evaluations);
+
+/// One row per shape and method (CSV with a header; numbers in full precision).
+/// Errors: kIo naming the file.
+Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations, const std::filesystem::path& path);
+
+/// A Markdown summary: the setup (`title` first), the per-method table, the timing and speedup, and the
+/// shapes that failed. Errors: kIo naming the file.
+Status writeEvaluationSummary(std::span<const FragmentEvaluation> evaluations, const std::string& title,
+                              const std::filesystem::path& path);
+
+/// Two PNG plots in `directory`: time.png (direct computation and query time against the shape's
+/// volume, log-log, as the paper's Figure 9) and error.png (first-frequency error of each method, one
+/// dot per shape, the median marked). Errors: kIo naming the file.
+Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
+                            const std::filesystem::path& directory);
+
+}  // namespace shapedb::io

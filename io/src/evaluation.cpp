@@ -1,0 +1,444 @@
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/evaluation.h>
+#include <shapedb/io/plot.h>
+#include <shapedb/volume/entry.h>
+
+namespace shapedb::io {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr std::array<core::DescriptorKind, 3> kDescriptors{
+    core::DescriptorKind::kMoment, core::DescriptorKind::kVoxel, core::DescriptorKind::kCentroidVoxel};
+constexpr std::size_t kCentroidVoxelIndex = 2;
+
+/// The relative errors of `f` against `truth` over their first n frequencies.
+void frequencyErrors(MethodEvaluation& m, const Eigen::VectorXd& f, const Eigen::VectorXd& truth, int n) {
+  n = std::min<int>({n, static_cast<int>(f.size()), static_cast<int>(truth.size())});
+  m.frequenciesHz = f.head(n);
+  if (n == 0) return;
+  m.firstFrequencyError = (f[0] - truth[0]) / truth[0];
+  double sum = 0.0, worst = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double e = std::abs(f[i] - truth[i]) / truth[i];
+    sum += e;
+    worst = std::max(worst, e);
+  }
+  m.meanFrequencyError = sum / n;
+  m.maxFrequencyError = worst;
+}
+
+/// Frequencies (Hz) of a surface's solid in `material`, computed directly: TetGen, then modes for unit
+/// E and ρ at the surface's own size, scaled by sqrt(E/ρ).
+Result<Eigen::VectorXd> directFrequencies(const core::TriangleMesh& surface,
+                                          const volume::EntryOptions& entry, const core::Material& material) {
+  Result<core::TetMesh> tets = volume::tetrahedralize(surface, entry.tetgen);
+  if (!tets) return tets.error();
+  Result<core::ModalData> modes = volume::computeModes(*tets, entry.modal);
+  if (!modes) return modes.error();
+  return Eigen::VectorXd(modes->frequenciesHz() * std::sqrt(material.youngsModulus / material.density));
+}
+
+double median(std::vector<double> v) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
+  if (v.empty()) return MethodEvaluation::kNaN;
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  const double upper = v[mid];
+  if (v.size() % 2 == 1) return upper;
+  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
+}
+
+double percentile(std::vector<double> v, double q) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
+  if (v.empty()) return MethodEvaluation::kNaN;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1,
+                    static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1)];
+}
+
+/// Fills one baseline: the inertia-equivalent solid `surface` (made in its principal frame, centred),
+/// placed at the shape's centre of mass along its principal axes for the overlap.
+void evaluateBaseline(MethodEvaluation& m, const core::TriangleMesh& surface,
+                      const core::SampledSolid& placed, const core::SampledSolid& shape,
+                      const volume::EntryOptions& entry, const EvaluationOptions& options,
+                      const Eigen::VectorXd& truth, std::string& error) {
+  Result<Eigen::VectorXd> f = directFrequencies(surface, entry, options.material);
+  if (!f) {
+    error = std::string(toString(m.method)) + " baseline: " + f.error().message;
+    return;
+  }
+  frequencyErrors(m, *f, truth, options.frequencies);
+  m.overlap = core::sampleOverlap(shape, placed, options.overlapResolution);
+}
+
+PlotSeries makeSeries(std::string label, std::array<std::uint8_t, 3> color,
+                      PlotSeries::Style style = PlotSeries::Style::kDots) {
+  PlotSeries s;
+  s.label = std::move(label);
+  s.color = color;
+  s.style = style;
+  return s;
+}
+
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s)
+    out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "";
+  std::ostringstream s;
+  s.precision(9);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+const char* toString(EvaluationMethod method) {
+  switch (method) {
+    case EvaluationMethod::kMoment:
+      return "moment";
+    case EvaluationMethod::kVoxel:
+      return "voxel";
+    case EvaluationMethod::kCentroidVoxel:
+      return "centroid-voxel";
+    case EvaluationMethod::kEllipsoid:
+      return "ellipsoid";
+    case EvaluationMethod::kBox:
+      return "box";
+  }
+  return "?";
+}
+
+double FragmentEvaluation::speedup() const {
+  if (methods.size() <= kCentroidVoxelIndex) return MethodEvaluation::kNaN;
+  const double query = methods[kCentroidVoxelIndex].queryMicros;
+  return query > 0.0 ? truthSeconds * 1e6 / query : MethodEvaluation::kNaN;
+}
+
+Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
+                                                       std::span<const NamedMesh> shapes,
+                                                       const EvaluationOptions& options) {
+  const volume::EntryOptions& entry = database.parameters().entry;
+  if (options.frequencies < 1 || options.frequencies > entry.modal.modes)
+    return Error{ErrorCode::kInvalidArgument, "frequencies to compare must be 1 to the database's " +
+                                                  std::to_string(entry.modal.modes) + " modes, not " +
+                                                  std::to_string(options.frequencies)};
+  if (options.overlapResolution < 8 || options.overlapResolution > 512)
+    return Error{ErrorCode::kInvalidArgument, "the overlap resolution must be 8 to 512 cells, not " +
+                                                  std::to_string(options.overlapResolution)};
+  if (Status st = core::validateMaterial(options.material); !st) return st.error();
+
+  std::vector<FragmentEvaluation> out(shapes.size());
+  // 1. The queries, one at a time: their timings are those of a machine doing nothing else.
+  std::vector<std::array<std::optional<QueryResult>, 3>> queries(shapes.size());
+  for (std::size_t i = 0; i < shapes.size(); ++i) {
+    FragmentEvaluation& e = out[i];
+    e.name = shapes[i].name;
+    e.triangles = shapes[i].mesh.triangles.size();
+    for (std::size_t k = 0; k < kDescriptors.size() && e.ok(); ++k) {
+      QueryOptions q;
+      q.descriptor = kDescriptors[k];
+      q.search.k = 1;
+      q.material = options.material;
+      q.fidelity = false;
+      Result<QueryResult> r = database.query(shapes[i].mesh, q);
+      if (!r)
+        e.error = std::string("query (") + core::toString(kDescriptors[k]) + "): " + r.error().message;
+      else
+        queries[i][k] = std::move(r).value();
+    }
+    if (e.ok()) e.volume = queries[i][0]->massProperties.volume;
+  }
+
+  // 2. The direct computations and the baselines, in parallel.
+  std::mutex progressMutex;
+  std::size_t done = 0;
+  auto evaluateOne = [&](std::size_t i) {
+    FragmentEvaluation& e = out[i];
+    const core::TriangleMesh& mesh = shapes[i].mesh;
+    if (e.ok()) {
+      Result<volume::EntryData> truth = volume::computeEntry(mesh, entry);
+      if (!truth) {
+        e.error = "direct computation: " + truth.error().message;
+      } else {
+        const volume::StageTimes& t = truth->times;
+        e.truthSeconds = t.normalize + t.tetrahedralize + t.modes + t.collision;  // describing is not needed
+        e.truthTets = truth->physics.tetMesh.tetCount();
+        Result<core::AdaptedPhysics> exact =
+            core::adapt(truth->physics, truth->normalization, truth->surfaceMassProperties,
+                        core::Mat3::Identity(), options.material, entry.damping);
+        if (!exact) {
+          e.error = "direct computation: " + exact.error().message;
+        } else {
+          e.truthFrequenciesHz = exact->frequenciesHz().head(
+              std::min<Eigen::Index>(options.frequencies, exact->eigenvalues.size()));
+          // The shape's solid, through the tets of its own direct computation.
+          const core::TetLocator locator(truth->physics.tetMesh);
+          const core::Mat4 toCanonical = truth->normalization.canonicalFromMesh;
+          const core::SampledSolid shape{[&](const core::Vec3& p) {
+                                           const core::Vec3 c = (toCanonical * p.homogeneous()).head<3>();
+                                           return locator.locate(c).inside();
+                                         },
+                                         core::computeBounds(mesh)};
+
+          for (std::size_t k = 0; k < kDescriptors.size(); ++k) {
+            const QueryResult& q = *queries[i][k];
+            MethodEvaluation m;
+            m.method = kEvaluationMethods[k];
+            m.match = q.matches.front().entry->name;
+            m.family = volume::toString(q.matches.front().entry->family);
+            m.distance = q.matches.front().match.distance;
+            frequencyErrors(m, q.physics->frequenciesHz(), e.truthFrequenciesHz, options.frequencies);
+            m.overlap = core::sampleOverlap(shape, core::sampledSolid(q.physics->collision),
+                                            options.overlapResolution);
+            m.queryMicros = q.times.total;
+            m.matchMicros = q.times.validate + q.times.massProperties + q.times.describe + q.times.search;
+            e.methods.push_back(std::move(m));
+          }
+
+          // The baselines, at the shape's centre of mass along its principal axes.
+          const core::Normalization& n = truth->normalization;
+          const core::Vec3 centre = truth->surfaceMassProperties.centerOfMass;
+          const double mass = truth->surfaceMassProperties.mass;
+          const core::Mat3 axes = n.principalAxes;
+
+          MethodEvaluation ellipsoid;
+          ellipsoid.method = EvaluationMethod::kEllipsoid;
+          const core::Vec3 radii = core::inertiaEquivalentEllipsoid(n.principalMoments, mass);
+          const core::Vec3 reach =
+              (axes.array().square().matrix() * radii.array().square().matrix()).cwiseSqrt();
+          const core::SampledSolid placedEllipsoid{
+              [&](const core::Vec3& p) {
+                return ((axes.transpose() * (p - centre)).array() / radii.array()).matrix().squaredNorm() <=
+                       1.0;
+              },
+              core::Bounds{centre - reach, centre + reach}};
+          const volume::ShapeResolution& res = database.parameters().resolution;
+          evaluateBaseline(ellipsoid,
+                           core::makeUvEllipsoid(radii, std::max(res.segments, 24), std::max(res.stacks, 12)),
+                           placedEllipsoid, shape, entry, options, e.truthFrequenciesHz, e.error);
+          e.methods.push_back(std::move(ellipsoid));
+
+          MethodEvaluation box;
+          box.method = EvaluationMethod::kBox;
+          core::CollisionCompound boxSolid;
+          core::CollisionShape boxShape;
+          boxShape.type = core::CollisionShape::Type::kBox;
+          boxShape.center = centre;
+          boxShape.rotation = axes;
+          boxShape.halfExtents = core::inertiaEquivalentBox(n.principalMoments, mass);
+          boxSolid.shapes.push_back(boxShape);
+          if (e.ok())
+            evaluateBaseline(box, core::makeBox(2.0 * boxShape.halfExtents), core::sampledSolid(boxSolid),
+                             shape, entry, options, e.truthFrequenciesHz, e.error);
+          e.methods.push_back(std::move(box));
+        }
+      }
+    }
+    if (options.progress) {
+      const std::lock_guard lock(progressMutex);
+      options.progress(++done, shapes.size(), e.name);
+    }
+  };
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] { tbb::parallel_for(std::size_t{0}, shapes.size(), evaluateOne); });
+  return out;
+}
+
+std::vector<MethodSummary> summarize(std::span<const FragmentEvaluation> evaluations) {
+  std::vector<MethodSummary> out;
+  for (std::size_t k = 0; k < kEvaluationMethods.size(); ++k) {
+    MethodSummary s;
+    s.method = kEvaluationMethods[k];
+    std::vector<double> first, mean, iou, query;
+    for (const FragmentEvaluation& e : evaluations) {
+      if (!e.ok() || e.methods.size() <= k) continue;
+      const MethodEvaluation& m = e.methods[k];
+      ++s.count;
+      first.push_back(std::abs(m.firstFrequencyError));
+      mean.push_back(m.meanFrequencyError);
+      iou.push_back(m.overlap.iou);
+      query.push_back(m.queryMicros);
+    }
+    s.medianFirstError = median(first);
+    s.p90FirstError = percentile(first, 0.9);
+    s.medianMeanError = median(mean);
+    s.medianIou = median(iou);
+    s.medianQueryMicros = median(query);
+    out.push_back(s);
+  }
+  return out;
+}
+
+Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
+                          const std::filesystem::path& path) {
+  std::ofstream file(path);
+  if (!file) return Error{ErrorCode::kIo, path.string() + ": cannot open for writing"};
+  file << "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
+          "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
+          "status\n";
+  for (const FragmentEvaluation& e : evaluations) {
+    const std::string head = csvField(e.name) + "," + std::to_string(e.triangles) + "," + number(e.volume) +
+                             "," + std::to_string(e.truthTets) + "," + number(e.truthSeconds) + ",";
+    if (e.methods.empty()) {
+      file << head << ",,,,,,,,,,,,,,," << csvField(e.error) << "\n";
+      continue;
+    }
+    for (const MethodEvaluation& m : e.methods) {
+      const double f1 = m.frequenciesHz.size() > 0 ? m.frequenciesHz[0] : MethodEvaluation::kNaN;
+      const double t1 = e.truthFrequenciesHz.size() > 0 ? e.truthFrequenciesHz[0] : MethodEvaluation::kNaN;
+      const bool descriptor = std::isfinite(m.queryMicros);
+      file << head << toString(m.method) << "," << csvField(m.match) << "," << m.family << ","
+           << number(m.distance) << "," << number(f1) << "," << number(t1) << ","
+           << number(m.firstFrequencyError) << "," << number(m.meanFrequencyError) << ","
+           << number(m.maxFrequencyError) << "," << m.frequenciesHz.size() << "," << number(m.overlap.iou)
+           << "," << number(m.overlap.coverage) << "," << number(m.overlap.overshoot) << ","
+           << number(m.queryMicros) << "," << number(m.matchMicros) << ","
+           << (descriptor ? number(e.truthSeconds * 1e6 / m.queryMicros) : std::string()) << ","
+           << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
+    }
+  }
+  file.flush();
+  if (!file) return Error{ErrorCode::kIo, path.string() + ": write failed"};
+  return Ok{};
+}
+
+Status writeEvaluationSummary(std::span<const FragmentEvaluation> evaluations, const std::string& title,
+                              const std::filesystem::path& path) {
+  std::ofstream file(path);
+  if (!file) return Error{ErrorCode::kIo, path.string() + ": cannot open for writing"};
+  std::size_t ok = 0;
+  std::vector<double> truth, tets, speedups, triangles;
+  for (const FragmentEvaluation& e : evaluations) {
+    if (!e.ok()) continue;
+    ++ok;
+    truth.push_back(e.truthSeconds);
+    tets.push_back(static_cast<double>(e.truthTets));
+    speedups.push_back(e.speedup());
+    triangles.push_back(static_cast<double>(e.triangles));
+  }
+  char line[512];
+  file << "# " << title << "\n\n";
+  file << ok << " of " << evaluations.size()
+       << " shapes evaluated. Errors are against the data computed directly on each shape with the "
+          "database's own pipeline and parameters (TetGen, linear FEM, shift-invert Lanczos).\n\n";
+  file << "| method | shapes | median abs. first-frequency error | p90 | median mean error, first "
+       << (evaluations.empty() || evaluations.front().truthFrequenciesHz.size() == 0
+               ? 0
+               : evaluations.front().truthFrequenciesHz.size())
+       << " | median collision-proxy IoU | median query |\n";
+  file << "|---|---:|---:|---:|---:|---:|---:|\n";
+  for (const MethodSummary& s : summarize(evaluations)) {
+    std::snprintf(line, sizeof line, "| %s | %zu | %.1f %% | %.1f %% | %.1f %% | %.3f | %s |\n",
+                  toString(s.method), s.count, 100.0 * s.medianFirstError, 100.0 * s.p90FirstError,
+                  100.0 * s.medianMeanError, s.medianIou,
+                  std::isfinite(s.medianQueryMicros)
+                      ? (std::to_string(static_cast<long>(std::lround(s.medianQueryMicros))) + " µs").c_str()
+                      : "(computed)");
+    file << line;
+  }
+  // How often the method beats both baselines, shape by shape.
+  std::size_t wins = 0, compared = 0;
+  for (const FragmentEvaluation& e : evaluations) {
+    if (!e.ok() || e.methods.size() < kEvaluationMethods.size()) continue;
+    const double cv = std::abs(e.methods[kCentroidVoxelIndex].firstFrequencyError);
+    ++compared;
+    wins +=
+        cv < std::abs(e.methods[3].firstFrequencyError) && cv < std::abs(e.methods[4].firstFrequencyError);
+  }
+  std::snprintf(
+      line, sizeof line,
+      "\nThe centroid-voxel match has a smaller first-frequency error than both baselines on %zu of %zu "
+      "shapes.\n\n",
+      wins, compared);
+  file << line;
+  std::snprintf(
+      line, sizeof line,
+      "Direct computation (tetrahedralize, modes, collision compound): median %.3g s, %.0f tets, for "
+      "a median %.0f triangles. The whole centroid-voxel query (match, fetch, adapt, link) is a "
+      "median %.0f× faster (min %.0f×).\n",
+      median(truth), median(tets), median(triangles), median(speedups),
+      speedups.empty() ? 0.0 : *std::min_element(speedups.begin(), speedups.end()));
+  file << line;
+  bool header = false;
+  for (const FragmentEvaluation& e : evaluations) {
+    if (e.ok()) continue;
+    if (!header) file << "\n## Shapes not evaluated\n\n";
+    header = true;
+    file << "- " << e.name << ": " << e.error << "\n";
+  }
+  file << "\nPer shape and method: evaluation.csv. Plots: time.png, error.png.\n";
+  file.flush();
+  if (!file) return Error{ErrorCode::kIo, path.string() + ": write failed"};
+  return Ok{};
+}
+
+Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
+                            const std::filesystem::path& directory) {
+  PlotSeries direct = makeSeries("direct: TetGen + FEM + modes + compound", {214, 39, 40});
+  PlotSeries query = makeSeries("query, centroid-voxel: match + fetch + adapt + link", {31, 119, 180});
+  PlotSeries match = makeSeries("describe + search", {44, 160, 44});
+  for (const FragmentEvaluation& e : evaluations) {
+    if (!e.ok()) continue;
+    const double t = e.volume * 1e6;  // cm³
+    direct.x.push_back(t);
+    direct.y.push_back(e.truthSeconds);
+    query.x.push_back(t);
+    query.y.push_back(e.methods[kCentroidVoxelIndex].queryMicros * 1e-6);
+    match.x.push_back(t);
+    match.y.push_back(e.methods[kCentroidVoxelIndex].matchMicros * 1e-6);
+  }
+  PlotAxes timeAxes;
+  timeAxes.title = "Physical data for each shape: computed directly, or queried";
+  timeAxes.xLabel = "volume of the shape, cm3";
+  timeAxes.yLabel = "seconds";
+  timeAxes.logX = timeAxes.logY = true;
+  const std::vector<PlotSeries> timeSeries{direct, query, match};
+  if (Status st = savePng(plotChart(timeAxes, timeSeries), directory / "time.png"); !st) return st;
+
+  PlotAxes errorAxes;
+  errorAxes.title = "First-frequency error against the direct computation, per shape";
+  errorAxes.xLabel = "method (bars: medians)";
+  errorAxes.yLabel = "|f1 - f1*| / f1*, %";
+  std::vector<PlotSeries> errorSeries;
+  const std::array<std::array<std::uint8_t, 3>, 5> colors{
+      {{148, 103, 189}, {255, 127, 14}, {31, 119, 180}, {140, 86, 75}, {127, 127, 127}}};
+  PlotSeries medians = makeSeries("", {0, 0, 0}, PlotSeries::Style::kTicks);
+  for (std::size_t k = 0; k < kEvaluationMethods.size(); ++k) {
+    errorAxes.categories.push_back(toString(kEvaluationMethods[k]));
+    PlotSeries dots = makeSeries("", colors[k]);
+    std::size_t j = 0;
+    std::vector<double> errors;
+    for (const FragmentEvaluation& e : evaluations) {
+      if (!e.ok() || e.methods.size() <= k) continue;
+      const double jitter = 0.3 * (std::fmod(0.6180339887 * static_cast<double>(++j), 1.0) - 0.5);
+      dots.x.push_back(static_cast<double>(k) + jitter);
+      dots.y.push_back(100.0 * std::abs(e.methods[k].firstFrequencyError));
+      errors.push_back(dots.y.back());
+    }
+    medians.x.push_back(static_cast<double>(k));
+    medians.y.push_back(median(errors));
+    errorSeries.push_back(std::move(dots));
+  }
+  errorSeries.push_back(std::move(medians));
+  return savePng(plotChart(errorAxes, errorSeries), directory / "error.png");
+}
+
+}  // namespace shapedb::io

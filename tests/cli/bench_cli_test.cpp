@@ -1,0 +1,132 @@
+// shapedb bench as a user runs it: a real database, a sphere broken by the real fracture, the CSV,
+// summary and plots read back.
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/mesh_io.h>
+
+#include "support/subprocess.h"
+#include "support/test_support.h"
+
+namespace shapedb::cli {
+namespace {
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted) {
+      fields.push_back(field);
+      field.clear();
+    } else
+      field += c;
+  }
+  fields.push_back(field);
+  return fields;
+}
+
+TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
+  test::ScratchDir dir("bench-cli");
+  const auto db = dir / "small.db";
+  test::ProcessResult built =
+      test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "9", "--families",
+                                     "box,ellipsoid,shard", "--modes", "5", "--quiet"});
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  const auto sphere = dir / "sphere.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeIcosphere(0.1, 4), sphere).ok());
+  const auto out = dir / "out";
+  test::ProcessResult r = test::runProcess(
+      SHAPEDB_CLI, {"bench", db.string(), "--fracture", sphere.string(), "--pieces", "3", "--resolution",
+                    "48", "--out", out.string(), "--material", "glass", "--threads", "2"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("| centroid-voxel |"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("direct computations done"), std::string::npos) << r.err;
+
+  std::ifstream csv(out / "evaluation.csv");
+  ASSERT_TRUE(csv.good());
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = splitCsv(line);
+  std::map<std::string, std::size_t> column;
+  for (std::size_t i = 0; i < header.size(); ++i)
+    column[header[i]] = i;
+  for (const char* name : {"shape", "method", "f1_hz", "f1_truth_hz", "f1_error", "iou", "speedup", "status"})
+    ASSERT_TRUE(column.count(name)) << name;
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(csv, line))
+    rows.push_back(splitCsv(line));
+  ASSERT_GE(rows.size(), 10u);  // 3 seeds: at least 2 fragments, 5 methods each
+  ASSERT_EQ(rows.size() % 5, 0u);
+  const std::vector<std::string> methods{"moment", "voxel", "centroid-voxel", "ellipsoid", "box"};
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    ASSERT_EQ(row.size(), header.size()) << i;
+    EXPECT_EQ(row[column["method"]], methods[i % 5]);
+    EXPECT_EQ(row[column["status"]], "ok") << row[column["shape"]];
+    const double f1 = std::stod(row[column["f1_hz"]]), truth = std::stod(row[column["f1_truth_hz"]]);
+    // Glass fragments of a 10 cm sphere ring in the kilohertz.
+    EXPECT_GT(truth, 1e3);
+    EXPECT_LT(truth, 1e6);
+    EXPECT_NEAR(std::stod(row[column["f1_error"]]), (f1 - truth) / truth, 1e-6);
+    EXPECT_LT(std::abs(std::stod(row[column["f1_error"]])), 1.0);  // same order of magnitude
+    const double iou = std::stod(row[column["iou"]]);
+    EXPECT_GT(iou, 0.2);
+    EXPECT_LE(iou, 1.0);
+    if (i % 5 < 3) {
+      EXPECT_GT(std::stod(row[column["speedup"]]), 1.0);
+    } else {
+      EXPECT_TRUE(row[column["speedup"]].empty());
+    }
+  }
+  std::ifstream md(out / "summary.md");
+  const std::string summary((std::istreambuf_iterator<char>(md)), {});
+  EXPECT_NE(summary.find("glass"), std::string::npos);
+  EXPECT_NE(summary.find("faster"), std::string::npos);
+  for (const char* png : {"time.png", "error.png"}) {
+    std::ifstream in(out / png, std::ios::binary);
+    char magic[8] = {};
+    in.read(magic, 8);
+    EXPECT_EQ(std::string(magic + 1, 3), "PNG") << png;
+  }
+}
+
+TEST(BenchCli, UsageAndInputErrorsAreClear) {
+  test::ScratchDir dir("bench-cli-errors");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box",
+                                           "--modes", "2", "--quiet"})
+                .exitCode,
+            0);
+  test::ProcessResult neither =
+      test::runProcess(SHAPEDB_CLI, {"bench", db.string(), "--out", (dir / "o").string()});
+  EXPECT_EQ(neither.exitCode, 2);
+  EXPECT_NE(neither.err.find("--queries DIR or --fracture"), std::string::npos) << neither.err;
+  test::ProcessResult missing = test::runProcess(
+      SHAPEDB_CLI,
+      {"bench", db.string(), "--queries", (dir / "nowhere").string(), "--out", (dir / "o").string()});
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("nowhere: not a directory"), std::string::npos) << missing.err;
+  const auto queries = dir / "q";
+  std::filesystem::create_directories(queries);
+  ASSERT_TRUE(io::saveMesh(core::makeBox({0.1, 0.1, 0.1}), queries / "cube.obj").ok());
+  test::ProcessResult tooMany = test::runProcess(
+      SHAPEDB_CLI, {"bench", db.string(), "--queries", queries.string(), "--out", (dir / "o").string()});
+  EXPECT_EQ(tooMany.exitCode, 2);  // 5 frequencies by default; the database has 2 modes
+  EXPECT_NE(tooMany.err.find("2 modes"), std::string::npos) << tooMany.err;
+  test::ProcessResult help = test::runProcess(SHAPEDB_CLI, {"bench", "--help"});
+  EXPECT_EQ(help.exitCode, 0);
+  EXPECT_NE(help.out.find("physical-fidelity benchmark"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace shapedb::cli

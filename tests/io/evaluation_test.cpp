@@ -1,0 +1,138 @@
+// The physical-fidelity benchmark on shapes whose answer is known: a shape that is in the database comes
+// back with its own data, and a box or an ellipsoid is its own inertia-equivalent baseline.
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/database.h>
+#include <shapedb/io/evaluation.h>
+#include <shapedb/volume/families.h>
+
+#include "support/test_support.h"
+
+namespace shapedb::io {
+namespace {
+
+TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
+  test::ScratchDir dir("evaluation");
+  const auto path = dir / "small.db";
+  BuildOptions build;
+  build.parameters.entries = 8;
+  build.parameters.families = {volume::Family::kBox, volume::Family::kEllipsoid};
+  build.parameters.entry.modal.modes = 6;
+  build.threads = 2;
+  auto report = buildDatabase(path, build);
+  ASSERT_TRUE(report.ok()) << report.error().message;
+  auto db = Database::open(path);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+
+  // An entry's own surface, turned, moved and scaled; a plain box; a smooth ellipsoid.
+  const EntryRecord& entry = db->entries()[1];
+  auto surface = volume::makeFamilyShape(
+      volume::familySpec(entry.family,
+                         static_cast<std::uint32_t>(std::stoul(entry.name.substr(entry.name.find('-') + 1)))),
+      db->parameters().resolution);
+  ASSERT_TRUE(surface.ok());
+  std::mt19937_64 rng(5);
+  std::vector<NamedMesh> shapes{
+      {"entry", "", core::transformed(*surface, test::randomSimilarity(rng, 2.0, 0.05, 0.2))},
+      {"box", "", core::makeBox({0.3, 0.2, 0.1})},
+      {"ellipsoid", "", core::makeUvEllipsoid({0.15, 0.1, 0.06}, 48, 24)},
+  };
+  EvaluationOptions options;
+  options.frequencies = 4;
+  options.overlapResolution = 40;
+  std::size_t progressCalls = 0;
+  options.progress = [&](std::size_t done, std::size_t total, const std::string&) {
+    ++progressCalls;
+    EXPECT_LE(done, total);
+  };
+  auto evaluations = evaluateShapes(*db, shapes, options);
+  ASSERT_TRUE(evaluations.ok()) << evaluations.error().message;
+  ASSERT_EQ(evaluations->size(), 3u);
+  EXPECT_EQ(progressCalls, 3u);
+  for (const FragmentEvaluation& e : *evaluations) {
+    ASSERT_TRUE(e.ok()) << e.name << ": " << e.error;
+    ASSERT_EQ(e.methods.size(), kEvaluationMethods.size());
+    ASSERT_EQ(e.truthFrequenciesHz.size(), 4);
+    EXPECT_GT(e.truthSeconds, 0.0);
+    EXPECT_GT(e.speedup(), 1.0) << e.name;  // a query beats TetGen + FEM + Lanczos on any machine
+    for (const MethodEvaluation& m : e.methods) {
+      EXPECT_EQ(m.frequenciesHz.size(), 4) << e.name << " " << toString(m.method);
+      EXPECT_GE(m.overlap.iou, 0.0);
+      EXPECT_LE(m.overlap.iou, 1.0);
+    }
+  }
+  // The entry comes back as itself from the centroid-voxel descriptor: the same data, up to TetGen
+  // meshing the moved surface differently.
+  const MethodEvaluation& self = (*evaluations)[0].methods[2];
+  EXPECT_EQ(self.match, entry.name);
+  EXPECT_LT(self.maxFrequencyError, 0.03);
+  EXPECT_GT(self.overlap.iou, 0.8);  // the compound's own fit to its shape
+  // The box is its own inertia-equivalent box, and the ellipsoid nearly its own ellipsoid.
+  const MethodEvaluation& box = (*evaluations)[1].methods[4];
+  EXPECT_LT(box.maxFrequencyError, 0.03);
+  EXPECT_GT(box.overlap.iou, 0.95);
+  const MethodEvaluation& ellipsoid = (*evaluations)[2].methods[3];
+  EXPECT_LT(ellipsoid.maxFrequencyError, 0.03);
+  EXPECT_GT(ellipsoid.overlap.iou, 0.95);
+  // And not the other way round: an ellipsoid is no box.
+  EXPECT_GT(std::abs((*evaluations)[2].methods[4].firstFrequencyError), 0.05);
+
+  // The files: one CSV row per shape and method, a summary naming every method, two PNGs.
+  ASSERT_TRUE(writeEvaluationCsv(*evaluations, dir / "e.csv").ok());
+  ASSERT_TRUE(writeEvaluationSummary(*evaluations, "test", dir / "summary.md").ok());
+  ASSERT_TRUE(writeEvaluationPlots(*evaluations, dir.path()).ok());
+  std::ifstream csv(dir / "e.csv");
+  std::string line;
+  std::size_t rows = 0;
+  while (std::getline(csv, line))
+    ++rows;
+  EXPECT_EQ(rows, 1 + 3 * kEvaluationMethods.size());
+  std::ifstream md(dir / "summary.md");
+  const std::string summary((std::istreambuf_iterator<char>(md)), {});
+  for (EvaluationMethod m : kEvaluationMethods)
+    EXPECT_NE(summary.find(std::string("| ") + toString(m) + " | 3 |"), std::string::npos) << summary;
+  for (const char* png : {"time.png", "error.png"})
+    EXPECT_GT(std::filesystem::file_size(dir / png), 1000u) << png;
+
+  // Bad options are errors before any work.
+  options.frequencies = 7;  // the database has 6 modes
+  EXPECT_EQ(evaluateShapes(*db, shapes, options).error().code, ErrorCode::kInvalidArgument);
+}
+
+TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
+  test::ScratchDir dir("evaluation-bad");
+  const auto path = dir / "small.db";
+  BuildOptions build;
+  build.parameters.entries = 4;
+  build.parameters.families = {volume::Family::kBox};
+  build.parameters.entry.modal.modes = 4;
+  auto report = buildDatabase(path, build);
+  ASSERT_TRUE(report.ok()) << report.error().message;
+  auto db = Database::open(path);
+  ASSERT_TRUE(db.ok());
+  core::TriangleMesh open = core::makeBox({1, 1, 1});
+  open.triangles.pop_back();
+  const std::vector<NamedMesh> shapes{{"open", "", open}, {"box", "", core::makeBox({0.2, 0.1, 0.1})}};
+  EvaluationOptions options;
+  options.frequencies = 4;
+  auto evaluations = evaluateShapes(*db, shapes, options);
+  ASSERT_TRUE(evaluations.ok()) << evaluations.error().message;
+  EXPECT_FALSE((*evaluations)[0].ok());
+  EXPECT_NE((*evaluations)[0].error.find("query"), std::string::npos) << (*evaluations)[0].error;
+  EXPECT_TRUE((*evaluations)[1].ok()) << (*evaluations)[1].error;
+  ASSERT_TRUE(writeEvaluationCsv(*evaluations, dir / "e.csv").ok());
+  std::ifstream csv(dir / "e.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), {});
+  EXPECT_NE(text.find("open,"), std::string::npos);
+  EXPECT_NE(text.find("query"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace shapedb::io
