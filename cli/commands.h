@@ -34,6 +34,7 @@ Command addQueryCommand(CLI::App& parent);
 Command addHapticCommand(CLI::App& parent);
 Command addFractureCommand(CLI::App& parent);
 Command addBenchCommand(CLI::App& parent);
+Command addSoundCommand(CLI::App& parent);
 
 /// Loads a mesh file and fractures it; errors name the file. Shared by fracture and haptic --fracture.
 Result<volume::FractureResult> fractureMeshFile(const std::string& path,

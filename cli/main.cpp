@@ -24,7 +24,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
                                    addInfoCommand(app),    addAddCommand(app),      addQueryCommand(app),
-                                   addHapticCommand(app),  addFractureCommand(app), addBenchCommand(app)};
+                                   addHapticCommand(app),  addFractureCommand(app), addBenchCommand(app),
+                                   addSoundCommand(app)};
 
   try {
     app.parse(argc, argv);
