@@ -1,16 +1,42 @@
 #include "support/subprocess.h"
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <linux/capability.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 
 #include "support/test_support.h"
 
 namespace shapedb::test {
+namespace {
 
-ProcessResult runProcess(const std::string& program, const std::vector<std::string>& args) {
+/// In the child: drops the capabilities that let root ignore file permissions, for good.
+bool dropFilePermissionOverride() {
+  if (::geteuid() != 0) return true;
+  for (const int cap : {CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH})
+    if (::prctl(PR_CAPBSET_DROP, cap, 0, 0, 0) != 0) return false;
+  __user_cap_header_struct header{_LINUX_CAPABILITY_VERSION_3, 0};
+  __user_cap_data_struct data[2] = {};
+  if (::syscall(SYS_capget, &header, data) != 0) return false;
+  const auto mask = ~((1u << CAP_DAC_OVERRIDE) | (1u << CAP_DAC_READ_SEARCH));
+  data[0].effective &= mask;
+  data[0].permitted &= mask;
+  data[0].inheritable &= mask;
+  return ::syscall(SYS_capset, &header, data) == 0;
+}
+
+}  // namespace
+
+ProcessResult runProcess(const std::string& program, const std::vector<std::string>& args,
+                         const RunOptions& options) {
   // Output goes to files in a scratch directory: no pipe can fill up and block the child.
   ScratchDir dir("process");
   const std::string outPath = (dir / "out").string(), errPath = (dir / "err").string();
@@ -26,12 +52,35 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   if (pid == 0) {
     if (!std::freopen(outPath.c_str(), "w", stdout) || !std::freopen(errPath.c_str(), "w", stderr))
       ::_exit(126);
+    if (options.fileSizeLimit > 0) {
+      // A write past the limit then fails with EFBIG instead of killing the child with SIGXFSZ.
+      const rlimit limit{options.fileSizeLimit, options.fileSizeLimit};
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(kSetupFailedExit);
+      std::signal(SIGXFSZ, SIG_IGN);
+    }
+    if (options.obeyFilePermissions && !dropFilePermissionOverride()) ::_exit(kSetupFailedExit);
     ::execv(program.c_str(), argv.data());
     ::_exit(127);
   }
   int status = 0;
-  ::waitpid(pid, &status, 0);
+  rusage usage{};
+  if (options.timeoutSeconds > 0.0) {
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
+    while (::wait4(pid, &status, WNOHANG, &usage) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(pid, SIGKILL);
+        result.timedOut = true;
+        ::wait4(pid, &status, 0, &usage);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  } else {
+    ::wait4(pid, &status, 0, &usage);
+  }
   result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.maxRssKiB = usage.ru_maxrss;
   std::ifstream out(outPath), err(errPath);
   result.out.assign(std::istreambuf_iterator<char>(out), {});
   result.err.assign(std::istreambuf_iterator<char>(err), {});
