@@ -2,11 +2,9 @@
 #include <array>
 #include <cctype>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <mutex>
-#include <sstream>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
@@ -15,6 +13,7 @@
 #include <shapedb/io/mesh_io.h>
 
 #include "openmesh_adapters.h"
+#include "text_mesh_readers.h"
 
 namespace shapedb::io {
 namespace {
@@ -64,48 +63,6 @@ Status checkStlFraming(const std::filesystem::path& path, std::uintmax_t fileSiz
   return fileError(path, ErrorCode::kParse, "not an STL file (too short for binary, no 'solid' for ASCII)");
 }
 
-// What a line-by-line look at a text mesh file finds before OpenMesh parses it.
-struct TextScan {
-  std::size_t vertexLines = 0;    // OBJ "v" lines
-  std::size_t nonFiniteLine = 0;  // first line with a NaN, infinite or overflowing number (1-based; 0 none)
-  std::string nonFiniteToken;
-};
-
-// OpenMesh's text readers skip or misread numbers they cannot parse as floats ("nan", "inf", "1e400"),
-// which shifts every later vertex. Find such numbers first, so the error says what is wrong and where.
-// Only data lines are scanned: comments and, for PLY, the header are skipped.
-TextScan scanText(const std::filesystem::path& path, const std::string& format) {
-  TextScan scan;
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  bool inData = format != "ply";
-  for (std::size_t number = 1; std::getline(in, line); ++number) {
-    if (!inData) {
-      if (line.rfind("format binary", 0) == 0) return scan;  // binary PLY: validated after reading
-      inData = line.rfind("end_header", 0) == 0;
-      continue;
-    }
-    std::istringstream words(line);
-    std::string word;
-    if (!(words >> word) || word[0] == '#') continue;
-    if (format == "obj") {
-      if (word != "v") continue;
-      ++scan.vertexLines;
-    } else {
-      words.seekg(0);
-    }
-    while (scan.nonFiniteLine == 0 && words >> word) {
-      char* end = nullptr;
-      const double value = std::strtod(word.c_str(), &end);
-      if (end == word.c_str() + word.size() && !std::isfinite(value)) {
-        scan.nonFiniteLine = number;
-        scan.nonFiniteToken = word;
-      }
-    }
-  }
-  return scan;
-}
-
 // Polygons fan-triangulated; polygons with fewer than three corners counted.
 struct Triangulated {
   core::TriangleMesh mesh;
@@ -114,21 +71,43 @@ struct Triangulated {
   std::size_t firstTooFew = 0;
 };
 
-Triangulated triangulate(detail::RawImporter&& raw) {
+Triangulated triangulate(detail::RawPolygons&& raw) {
   Triangulated out;
   out.mesh.vertices = std::move(raw.vertices);
-  out.mesh.triangles.reserve(raw.polygons.size());
-  for (std::size_t f = 0; f < raw.polygons.size(); ++f) {
-    const auto& polygon = raw.polygons[f];
-    if (polygon.size() < 3) {
+  out.mesh.triangles.reserve(raw.polygonCount());
+  for (std::size_t f = 0; f < raw.polygonCount(); ++f) {
+    const std::uint32_t* polygon = raw.corners.data() + raw.begin(f);
+    const std::size_t corners = raw.ends[f] - raw.begin(f);
+    if (corners < 3) {
       if (out.tooFewCorners++ == 0) out.firstTooFew = f;
       continue;
     }
-    if (polygon.size() > 3) ++out.polygons;
-    for (std::size_t i = 1; i + 1 < polygon.size(); ++i)
+    if (corners > 3) ++out.polygons;
+    for (std::size_t i = 1; i + 1 < corners; ++i)
       out.mesh.triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
   }
   return out;
+}
+
+// STL through OpenMesh's reader, once checkStlFraming has checked the file's size against its count.
+// (OBJ, OFF and PLY have shapedb's own readers: text_mesh_readers.h says why.)
+Result<detail::RawPolygons> readStl(const std::filesystem::path& path) {
+  // No OpenMesh exception crosses this function.
+  detail::RawImporter importer;
+  bool parsed = false;
+  {
+    std::lock_guard lock(openMeshMutex());
+    try {
+      OpenMesh::IO::Options readOptions;
+      parsed = OpenMesh::IO::IOManager().read(path.string(), importer, readOptions);
+    } catch (const std::exception& e) {
+      return fileError(path, ErrorCode::kParse, std::string("parse error: ") + e.what());
+    } catch (...) {
+      return fileError(path, ErrorCode::kParse, "parse error");
+    }
+  }
+  if (!parsed) return fileError(path, ErrorCode::kParse, "could not parse as STL");
+  return std::move(importer.raw);
 }
 
 // OpenMesh's writers need one of its own kernels; double-precision points so nothing is lost before
@@ -179,38 +158,18 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   if (format == "stl") {
     if (Status framing = checkStlFraming(path, fileSize); !framing) return framing.error();
   }
-  const TextScan scan = format == "stl" ? TextScan{} : scanText(path, format);
-  if (scan.nonFiniteLine > 0)
-    return fileError(
-        path, ErrorCode::kNonFinite,
-        "line " + std::to_string(scan.nonFiniteLine) + ": non-finite number '" + scan.nonFiniteToken + "'");
-
-  // Parse through OpenMesh into the raw importer; no OpenMesh exception crosses this function.
-  detail::RawImporter raw;
-  bool parsed = false;
-  {
-    std::lock_guard lock(openMeshMutex());
-    try {
-      OpenMesh::IO::Options readOptions;
-      parsed = OpenMesh::IO::IOManager().read(path.string(), raw, readOptions);
-    } catch (const std::exception& e) {
-      return fileError(path, ErrorCode::kParse, std::string("parse error: ") + e.what());
-    } catch (...) {
-      return fileError(path, ErrorCode::kParse, "parse error");
-    }
-  }
-  if (!parsed) return fileError(path, ErrorCode::kParse, "could not parse as " + format);
-  if (format == "obj" && raw.vertices.size() != scan.vertexLines)
-    return fileError(path, ErrorCode::kParse,
-                     std::to_string(scan.vertexLines) + " vertex lines, but only " +
-                         std::to_string(raw.vertices.size()) + " could be parsed");
+  Result<detail::RawPolygons> raw = format == "obj"   ? detail::readObj(path)
+                                    : format == "off" ? detail::readOff(path)
+                                    : format == "ply" ? detail::readPly(path)
+                                                      : readStl(path);
+  if (!raw) return raw.error();
 
   // Triangulate, then validate what was read.
-  Triangulated tri = triangulate(std::move(raw));
+  Triangulated tri = triangulate(std::move(raw).value());
   if (tri.tooFewCorners > 0 && !options.allowDegenerateFaces)
     return fileError(path, ErrorCode::kDegenerateFace,
-                     std::to_string(tri.tooFewCorners) + " faces with fewer than 3 vertices (first: face " +
-                         std::to_string(tri.firstTooFew) + ")");
+                     std::to_string(tri.tooFewCorners) + (tri.tooFewCorners == 1 ? " face" : " faces") +
+                         " with fewer than 3 vertices (first: face " + std::to_string(tri.firstTooFew) + ")");
   LoadedMesh out;
   out.mesh = std::move(tri.mesh);
   out.format = format;

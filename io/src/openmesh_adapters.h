@@ -5,12 +5,11 @@
 // so that topology is judged by shapedb (analyzeTopology), not silently repaired.
 
 #include <cstdint>
-#include <limits>
 #include <vector>
 
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 
-#include <shapedb/core/triangle_mesh.h>
+#include "raw_polygons.h"
 
 namespace shapedb::io::detail {
 
@@ -21,32 +20,29 @@ class RawImporter final : public OpenMesh::IO::BaseImporter {
   using FH = OpenMesh::FaceHandle;
   using HH = OpenMesh::HalfedgeHandle;
   using EH = OpenMesh::EdgeHandle;
-  static constexpr std::uint32_t kInvalidIndex = std::numeric_limits<std::uint32_t>::max();
 
-  std::vector<core::Vec3> vertices;
-  std::vector<std::vector<std::uint32_t>> polygons;  // kInvalidIndex for a negative index
+  RawPolygons raw;
 
   VH add_vertex(const OpenMesh::Vec3f& p) override { return add_vertex(OpenMesh::Vec3d(p)); }
   VH add_vertex(const OpenMesh::Vec3d& p) override {
-    vertices.emplace_back(p[0], p[1], p[2]);
-    return VH(static_cast<int>(vertices.size() - 1));
+    raw.vertices.emplace_back(p[0], p[1], p[2]);
+    return VH(static_cast<int>(raw.vertices.size() - 1));
   }
   VH add_vertex() override { return add_vertex(OpenMesh::Vec3d(0.0, 0.0, 0.0)); }
   void set_point(VH vh, const OpenMesh::Vec3f& p) override {
-    if (vh.is_valid() && static_cast<std::size_t>(vh.idx()) < vertices.size())
-      vertices[static_cast<std::size_t>(vh.idx())] = core::Vec3(p[0], p[1], p[2]);
+    if (vh.is_valid() && static_cast<std::size_t>(vh.idx()) < raw.vertices.size())
+      raw.vertices[static_cast<std::size_t>(vh.idx())] = core::Vec3(p[0], p[1], p[2]);
   }
   FH add_face(const VHandles& indices) override {
-    std::vector<std::uint32_t>& polygon = polygons.emplace_back();
-    polygon.reserve(indices.size());
     for (const VH& vh : indices)
-      polygon.push_back(vh.idx() < 0 ? kInvalidIndex : static_cast<std::uint32_t>(vh.idx()));
-    return FH(static_cast<int>(polygons.size() - 1));
+      raw.corners.push_back(vh.idx() < 0 ? RawPolygons::kInvalidIndex : static_cast<std::uint32_t>(vh.idx()));
+    raw.endPolygon();
+    return FH(static_cast<int>(raw.polygonCount() - 1));
   }
   FH add_face(HH) override { return FH(); }
   HH add_edge(VH, VH) override { return HH(); }
-  std::size_t n_vertices() const override { return vertices.size(); }
-  std::size_t n_faces() const override { return polygons.size(); }
+  std::size_t n_vertices() const override { return raw.vertices.size(); }
+  std::size_t n_faces() const override { return raw.polygonCount(); }
   std::size_t n_edges() const override { return 0; }
   // Reserve requests come from file headers, which may lie: never allocate on their word.
   void reserve(unsigned int, unsigned int, unsigned int) override {}

@@ -1,6 +1,5 @@
 #include <cstring>
 #include <fstream>
-#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -8,6 +7,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "support/mesh_files.h"
 #include "support/test_support.h"
 
 namespace shapedb::io {
@@ -16,50 +16,9 @@ namespace {
 using core::TriangleMesh;
 using core::Vec3;
 
-// Writers for the formats shapedb only reads, so that tests can make real files of each.
-std::string offText(const TriangleMesh& mesh) {
-  std::ostringstream out;
-  out.precision(17);
-  out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n";
-  for (const Vec3& p : mesh.vertices)
-    out << p.x() << " " << p.y() << " " << p.z() << "\n";
-  for (const auto& t : mesh.triangles)
-    out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
-  return out.str();
-}
-
-std::string asciiStl(const TriangleMesh& mesh) {
-  std::ostringstream out;
-  out.precision(9);
-  out << "solid test\n";
-  for (const auto& t : mesh.triangles) {
-    out << "facet normal 0 0 0\nouter loop\n";
-    for (auto v : t)
-      out << "vertex " << mesh.vertices[v].x() << " " << mesh.vertices[v].y() << " " << mesh.vertices[v].z()
-          << "\n";
-    out << "endloop\nendfacet\n";
-  }
-  out << "endsolid test\n";
-  return out.str();
-}
-
-std::string binaryStl(const TriangleMesh& mesh, std::uint32_t claimedCount) {
-  std::string out(80, ' ');
-  out.append(reinterpret_cast<const char*>(&claimedCount), 4);
-  for (const auto& t : mesh.triangles) {
-    float record[12] = {};
-    for (int k = 0; k < 3; ++k)
-      for (int c = 0; c < 3; ++c)
-        record[3 + 3 * k + c] = static_cast<float>(mesh.vertices[t[k]][c]);
-    out.append(reinterpret_cast<const char*>(record), sizeof record);
-    out.append(2, '\0');
-  }
-  return out;
-}
-
-std::string binaryStl(const TriangleMesh& mesh) {
-  return binaryStl(mesh, static_cast<std::uint32_t>(mesh.triangles.size()));
-}
+using test::asciiStl;
+using test::binaryStl;
+using test::offText;
 
 LoadedMesh mustLoad(const std::filesystem::path& path, const LoadOptions& options = {}) {
   Result<LoadedMesh> loaded = loadMesh(path, options);
@@ -222,6 +181,10 @@ TEST(MeshIo, InvalidContentIsReportedWithItsCode) {
        "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n",
        ErrorCode::kNonFinite},
       {"unparsable_vertex.obj", "v 0 0 zero\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + faces, ErrorCode::kParse},
+      {"two_coordinates.obj", "v 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + faces, ErrorCode::kParse},
+      {"corner_without_vertex.obj", tet + faces + "f /1 2/1 3/1\n", ErrorCode::kParse},
+      {"zero_index.obj", tet + faces + "f 0 1 2\n", ErrorCode::kIndexOutOfRange},
+      {"index_beyond_int.obj", tet + faces + "f 1 2 99999999999999999999\n", ErrorCode::kIndexOutOfRange},
       {"repeated.off",
        "OFF\n4 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 0 0 1\n",
        ErrorCode::kDegenerateFace},
@@ -236,14 +199,38 @@ TEST(MeshIo, InvalidContentIsReportedWithItsCode) {
   }
 }
 
-TEST(MeshIo, ObjReaderDropsRepeatedVertexFacesItself) {
-  // OpenMesh's OBJ reader removes a face such as "f 1 1 2" while parsing; it never reaches shapedb.
+TEST(MeshIo, ObjRepeatedCornersAreMergedAndAFaceLeftWithTwoIsDegenerate) {
   test::ScratchDir dir("io");
+  // "f 1 1 2" is an edge once its repeated corner is merged: degenerate, dropped only when asked.
   test::writeFile(dir / "tet.obj",
                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 1 2\n");
-  const LoadedMesh loaded = mustLoad(dir / "tet.obj");
+  EXPECT_EQ(mustFail(dir / "tet.obj").code, ErrorCode::kDegenerateFace);
+  const LoadedMesh loaded = mustLoad(dir / "tet.obj", {.allowDegenerateFaces = true});
   EXPECT_EQ(loaded.mesh.triangles.size(), 4u);
+  EXPECT_EQ(loaded.facesDropped, 1u);
   EXPECT_TRUE(loaded.topology.isClosed());
+  // A quad with a corner repeated (as some exporters write) is the triangle it is.
+  test::writeFile(dir / "quad.obj",
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 3 2\nf 1 2 4 1\nf 2 3 4\nf 1 4 3\n");
+  const LoadedMesh quad = mustLoad(dir / "quad.obj");
+  EXPECT_EQ(quad.mesh.triangles.size(), 4u);
+  EXPECT_EQ(quad.polygonsTriangulated, 0u);
+}
+
+TEST(MeshIo, ObjReaderReadsOnlyGeometryAndNeverAnotherFile) {
+  test::ScratchDir dir("io");
+  // Texture and normal indices, relative indices, groups, materials (mtllib naming a file that would
+  // never end), tabs and CRLF: the geometry alone is read, in double precision.
+  test::writeFile(dir / "cube.obj",
+                  "mtllib /dev/zero\r\nusemtl steel\r\no cube\r\n"
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1.000000000000001\n"
+                  "vt 0 0\nvn 0 0 1\ng sides\ns off\n"
+                  "f 1/1 3/1 4/1 2/1\nf 5//1 6//1 8//1 7//1\nf\t1/1/1\t2/1/1\t6/1/1\t5/1/1\r\n"
+                  "f -6 -2 -1 -5\nf 1 5 7 3\nf 2 4 8 6\nl 1 2\n");
+  const LoadedMesh loaded = mustLoad(dir / "cube.obj");
+  EXPECT_EQ(loaded.mesh.triangles.size(), 12u);
+  EXPECT_TRUE(loaded.topology.isClosed());
+  EXPECT_EQ(loaded.mesh.vertices[7].z(), 1.000000000000001);
 }
 
 TEST(MeshIo, DegenerateFacesAreAcceptedOnlyWhenAsked) {

@@ -27,8 +27,9 @@ struct LoadedMesh {
   std::size_t facesDropped = 0;          ///< repeated-vertex faces dropped under allowDegenerateFaces
 };
 
-/// Reads an OBJ, PLY (ASCII or binary), OFF or STL (ASCII or binary) file through OpenMesh, chosen by
-/// extension (case-insensitive), coordinates in single precision as OpenMesh's readers parse them.
+/// Reads an OBJ, PLY (ASCII or binary), OFF or STL (ASCII or binary) file, chosen by extension
+/// (case-insensitive): OBJ by shapedb's own reader (double precision; only `v` and `f` statements are
+/// read, no other file is opened), the others through OpenMesh (single precision, as its readers parse).
 /// Polygons are fan-triangulated; vertices are kept as the file has them
 /// (STL's duplicated corners are merged by OpenMesh's reader). Every error names the file:
 /// "part.stl: truncated binary STL (header says 12 triangles, file holds 3)". Errors: kIo, kUnknownFormat,
