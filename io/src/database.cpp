@@ -186,6 +186,8 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
   if (Status st = store.setMeta("build_seconds", std::to_string(previous + report.seconds)); !st)
     return st.error();
   if (Status st = store.setMeta("status", "complete"); !st) return st.error();
+  // Best effort: a reader holding the file open keeps it in WAL mode, which is as valid.
+  static_cast<void>(store.finish());
   return report;
 }
 
@@ -223,6 +225,7 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
     data.push_back(std::move(results[i]).value());
   }
   if (Status st = store->write(records, data); !st) return st.error();
+  static_cast<void>(store->finish());  // best effort, as at the end of a build
   return ids;
 }
 

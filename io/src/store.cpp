@@ -1,4 +1,5 @@
 #include <array>
+#include <cstring>
 #include <mutex>
 
 #include <nlohmann/json.hpp>
@@ -37,9 +38,7 @@ CREATE TABLE failures(name TEXT PRIMARY KEY, message TEXT NOT NULL);
 /// A prepared statement that finalizes itself.
 class Statement {
  public:
-  Statement(sqlite3* db, const char* sql) : mDb(db) {
-    mRc = sqlite3_prepare_v2(db, sql, -1, &mStmt, nullptr);
-  }
+  Statement(sqlite3* db, const char* sql) { mRc = sqlite3_prepare_v2(db, sql, -1, &mStmt, nullptr); }
   ~Statement() { sqlite3_finalize(mStmt); }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
@@ -70,7 +69,6 @@ class Statement {
   }
 
  private:
-  sqlite3* mDb;
   sqlite3_stmt* mStmt = nullptr;
   int mRc;
 };
@@ -164,13 +162,23 @@ struct Store::Impl {
   BuildParameters parameters;
   ~Impl() { sqlite3_close_v2(db); }
 
+  /// SQLite's word for the last failure, with the operating system's where it kept one, and what a
+  /// failed write most likely means.
+  std::string failure(const char* sqliteMessage) const {
+    std::string text = sqliteMessage;
+    if (const int os = sqlite3_system_errno(db); os != 0) text += " (" + std::string(std::strerror(os)) + ")";
+    const int code = sqlite3_extended_errcode(db);
+    if (code == SQLITE_IOERR_WRITE || (code & 0xff) == SQLITE_FULL)
+      text += "; is the disk full? What was committed before is kept (a build continues with --resume)";
+    return text;
+  }
   Error sqlError(const std::string& what) const {
-    return Error{ErrorCode::kIo, path.string() + ": " + what + ": " + sqlite3_errmsg(db)};
+    return Error{ErrorCode::kIo, path.string() + ": " + what + ": " + failure(sqlite3_errmsg(db))};
   }
   Status exec(const char* sql) {
     char* message = nullptr;
     if (sqlite3_exec(db, sql, nullptr, nullptr, &message) != SQLITE_OK) {
-      const std::string text = message ? message : "unknown error";
+      const std::string text = failure(message ? message : "unknown error");
       sqlite3_free(message);
       return Error{ErrorCode::kIo, path.string() + ": " + text};
     }
@@ -234,9 +242,17 @@ Result<Store> Store::open(const std::filesystem::path& path, bool writable) {
   auto impl = Impl::connect(path, writable ? SQLITE_OPEN_READWRITE : SQLITE_OPEN_READONLY);
   if (!impl) return impl.error();
   Impl& s = **impl;
+  if (writable && sqlite3_db_readonly(s.db, "main") == 1)
+    return Error{ErrorCode::kIo, path.string() + ": the file is read-only (no write permission)"};
   const auto application = s.pragma("PRAGMA application_id");
-  if (!application)
-    return Error{ErrorCode::kParse, path.string() + ": not a database file (" + sqlite3_errmsg(s.db) + ")"};
+  if (!application) {
+    if ((sqlite3_extended_errcode(s.db) & 0xff) == SQLITE_NOTADB)
+      return Error{ErrorCode::kParse, path.string() + ": not a database file"};
+    // A file left in write-ahead-log mode (a build or add that did not finish) needs its folder
+    // writable even to be read: SQLite keeps the log's index in a file beside it.
+    return Error{ErrorCode::kIo, path.string() + ": cannot read it (" + sqlite3_errmsg(s.db) +
+                                     "); a file whose build or add did not finish needs a writable folder"};
+  }
   if (*application != kApplicationId)
     return Error{ErrorCode::kParse, path.string() + ": not a shapedb database"};
   const auto version = s.pragma("PRAGMA user_version");
@@ -253,6 +269,10 @@ Result<Store> Store::open(const std::filesystem::path& path, bool writable) {
   if (!parameters) return withContext(parameters.error(), path.string());
   store.mImpl->parameters = std::move(parameters).value();
   return store;
+}
+
+Status Store::finish() {
+  return mImpl->exec("PRAGMA journal_mode=DELETE");
 }
 
 Status Store::setMeta(const std::string& key, const std::string& value) {

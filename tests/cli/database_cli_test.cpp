@@ -122,6 +122,77 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
   EXPECT_NE(conflict.err.find("was built with another modes"), std::string::npos) << conflict.err;
 }
 
+TEST(BuildCli, AFullDiskFailsClearlyKeepsWhatWasCommittedAndTheBuildResumes) {
+  test::ScratchDir dir("build-full");
+  const auto full = dir / "full.db", clean = dir / "clean.db";
+  const std::vector<std::string> args = {"--entries", "24", "--families", "box,cone,shard",
+                                         "--modes",   "4",  "--threads",  "1",
+                                         "--batch",   "2",  "--quiet"};
+  // No file may grow past 300 kB (the finished file is ~2 MB): a disk that fills up mid-build.
+  std::vector<std::string> build = {"build", full.string()};
+  build.insert(build.end(), args.begin(), args.end());
+  const test::ProcessResult failed = test::runProcess(SHAPEDB_CLI, build, {.fileSizeLimit = 300'000});
+  ASSERT_NE(failed.exitCode, test::kSetupFailedExit) << "could not set RLIMIT_FSIZE";
+  EXPECT_EQ(failed.exitCode, 1) << failed.err;
+  EXPECT_NE(failed.err.find(full.string() + ": "), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("is the disk full?"), std::string::npos) << failed.err;
+  const std::size_t kept = committedEntries(full);
+  std::printf("the full disk stopped the build with %zu of 24 entries committed\n", kept);
+  EXPECT_GE(kept, 2u);
+  EXPECT_LT(kept, 24u);
+
+  // Room again: the build resumes and ends as a clean build does.
+  const test::ProcessResult resumed =
+      test::runProcess(SHAPEDB_CLI, {"build", full.string(), "--resume", "--quiet"});
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  std::vector<std::string> cleanBuild = {"build", clean.string()};
+  cleanBuild.insert(cleanBuild.end(), args.begin(), args.end());
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, cleanBuild).exitCode, 0);
+  EXPECT_EQ(committedEntries(full), 24u);
+  EXPECT_TRUE(dumpEntries(full) == dumpEntries(clean)) << "the resumed database differs from a clean build";
+}
+
+TEST(BuildCli, AReadOnlyDatabaseIsQueriedAndWritesAreRefusedWithNothingChanged) {
+  test::ScratchDir dir("build-readonly");
+  const auto folder = dir / "shipped";
+  std::filesystem::create_directories(folder);
+  const auto db = folder / "small.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "4", "--families", "box",
+                                           "--modes", "2", "--quiet"})
+                .exitCode,
+            0);
+  const auto mesh = dir / "box.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeBox({0.3, 0.2, 0.1}), mesh).ok());
+  const std::string before = dumpEntries(db);
+  // A shipped database: the file and its folder read-only (as on a read-only medium).
+  namespace fs = std::filesystem;
+  fs::permissions(db, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                              fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const test::RunOptions readOnly{.obeyFilePermissions = true};
+
+  const test::ProcessResult query =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), mesh.string(), "--json"}, readOnly);
+  ASSERT_NE(query.exitCode, test::kSetupFailedExit)
+      << "could not drop the capabilities that override permissions";
+  EXPECT_EQ(query.exitCode, 0) << query.err;
+  EXPECT_EQ(nlohmann::json::parse(query.out)["queries"][0]["matches"][0]["family"], "box");
+  const test::ProcessResult info = test::runProcess(SHAPEDB_CLI, {"info", db.string()}, readOnly);
+  EXPECT_EQ(info.exitCode, 0) << info.err;
+
+  for (const std::vector<std::string>& write :
+       {std::vector<std::string>{"add", db.string(), mesh.string()},
+        std::vector<std::string>{"build", db.string(), "--resume", "--quiet"}}) {
+    const test::ProcessResult refused = test::runProcess(SHAPEDB_CLI, write, readOnly);
+    EXPECT_EQ(refused.exitCode, 1) << write[0] << ": " << refused.err;
+    EXPECT_NE(refused.err.find(db.string() + ": the file is read-only"), std::string::npos) << refused.err;
+  }
+  fs::permissions(folder, fs::perms::owner_all);
+  fs::permissions(db, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_TRUE(dumpEntries(db) == before) << "a refused write changed the file";
+  EXPECT_FALSE(fs::exists(db.string() + "-wal"));
+}
+
 TEST(BuildCli, InfoAndAddEndToEnd) {
   test::ScratchDir dir("build-info");
   const auto db = dir / "small.db";

@@ -60,8 +60,8 @@ class Store {
  public:
   /// A new file. Errors: kIo if it exists or cannot be created.
   static Result<Store> create(const std::filesystem::path& path, const BuildParameters& parameters);
-  /// An existing file. Errors: kIo (missing, unreadable, not SQLite), kParse (another application's
-  /// file, another schema version, unreadable parameters).
+  /// An existing file. Errors: kIo (missing, unreadable; `writable` and the file is read-only), kParse
+  /// (not SQLite, another application's file, another schema version, unreadable parameters).
   static Result<Store> open(const std::filesystem::path& path, bool writable = false);
 
   Store(Store&&) noexcept;
@@ -84,6 +84,11 @@ class Store {
   /// One entry's physical data, checksums verified. Errors: kInvalidArgument (no such entry), kParse
   /// (a corrupted blob: the message names the entry and the part).
   Result<core::PhysicalData> physics(core::EntryId id) const;
+
+  /// Checkpoints the write-ahead log into the file and leaves it in rollback-journal mode: one
+  /// self-contained file, readable from a read-only folder or medium. The next write switches back
+  /// to WAL. Fails (harmlessly: the file stays valid in WAL mode) while another connection has it open.
+  Status finish();
 
   /// Free-form bookkeeping: "build_seconds", "status", "created".
   Status setMeta(const std::string& key, const std::string& value);
