@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs shapedb's Debian 12 packages (only those missing; silent when all are there) and builds one
-# CMake preset (default: release). Usage: scripts/setup.sh [release|debug|asan|tsan]
+# CMake preset (default: release). Usage: scripts/setup.sh [release|debug|asan|tsan|fuzz]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
