@@ -1,0 +1,331 @@
+// The hostile-input corpus: malformed, lying, degenerate and extreme mesh files, each given to the real
+// `shapedb query` (the whole pipeline: read, validate, mass properties, frame, descriptors, search,
+// adapt, link) as a subprocess. Each must give its documented error (exit 1, the file named, the problem
+// said) or its documented result (exit 0), never a crash, a hang, or unbounded memory. The table is
+// docs/hostile-input.md.
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <shapedb/core/primitives.h>
+
+#include "support/mesh_files.h"
+#include "support/subprocess.h"
+#include "support/test_support.h"
+
+namespace shapedb::cli {
+namespace {
+
+using core::TriangleMesh;
+using core::Vec3;
+
+const std::string kTet = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+const std::string kTetFaces = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+
+std::string plyHeader(const std::string& format, std::size_t vertices, std::size_t faces) {
+  return "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(faces) +
+         "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+const std::string kPlyTetBody = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+
+std::string binaryPlyTet(std::size_t claimedVertices, std::size_t claimedFaces) {
+  std::string out = plyHeader("binary_little_endian", claimedVertices, claimedFaces);
+  const float v[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  out.append(reinterpret_cast<const char*>(v), sizeof v);
+  const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  for (const auto& face : f) {
+    out.push_back(3);
+    out.append(reinterpret_cast<const char*>(face), sizeof face);
+  }
+  return out;
+}
+
+TriangleMesh scaled(TriangleMesh mesh, double s) {
+  for (Vec3& p : mesh.vertices)
+    p *= s;
+  return mesh;
+}
+
+/// A box whose faces share no vertex: every corner repeated per triangle, as a triangle soup is.
+TriangleMesh soup(const TriangleMesh& mesh) {
+  TriangleMesh out;
+  for (const auto& t : mesh.triangles) {
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
+    for (auto v : t)
+      out.vertices.push_back(mesh.vertices[v]);
+    out.triangles.push_back({base, base + 1, base + 2});
+  }
+  return out;
+}
+
+TriangleMesh reversed(TriangleMesh mesh, std::size_t count) {
+  for (std::size_t i = 0; i < count && i < mesh.triangles.size(); ++i)
+    std::swap(mesh.triangles[i][1], mesh.triangles[i][2]);
+  return mesh;
+}
+
+TriangleMesh merged(const TriangleMesh& a, const TriangleMesh& b) {
+  TriangleMesh out = a;
+  const auto offset = static_cast<std::uint32_t>(a.vertices.size());
+  out.vertices.insert(out.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (auto t : b.triangles)
+    out.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return out;
+}
+
+TriangleMesh translated(TriangleMesh mesh, const Vec3& d) {
+  for (Vec3& p : mesh.vertices)
+    p += d;
+  return mesh;
+}
+
+/// What a case must give. An error: exit 1 and `message` in what is printed (the file is always
+/// named). A result: exit 0 and `check` holds on the query's JSON.
+struct Case {
+  std::string file;  ///< name, with the extension that picks the reader
+  std::function<std::string()> content;
+  std::string message;  ///< empty: the query must succeed
+  std::function<void(const nlohmann::json&)> check = {};
+};
+
+std::vector<Case> corpus() {
+  const TriangleMesh box = core::makeBox({0.3, 0.2, 0.1});
+  const TriangleMesh blob = core::makeIcosphere(0.1, 3);
+  std::string garbage;
+  for (int i = 0; i < 4096; ++i)
+    garbage.push_back(static_cast<char>((i * 7919 + 13) % 256));
+  auto massNear = [](double volume) {
+    const double expected = 7850.0 * volume;
+    return [expected](const nlohmann::json& q) {
+      EXPECT_NEAR(q["physics"]["mass"].get<double>(), expected, 1e-5 * expected);  // steel, the default
+    };
+  };
+  return {
+      // Files that are not what they say.
+      {"empty.obj", [] { return std::string(); }, "file is empty"},
+      {"garbage.obj", [=] { return garbage; }, "no faces"},
+      {"garbage.stl", [=] { return garbage; }, "binary STL"},
+      {"garbage.ply", [=] { return garbage; }, "not a PLY file"},
+      {"unknown.xyz", [] { return kTet + kTetFaces; }, "unknown mesh format"},
+      // Binary STL: cut short, a count that lies (2³¹), none at all, or ASCII's "solid" on binary data.
+      {"truncated.stl", [=] { return test::binaryStl(box).substr(0, 84 + 50 * 5 + 17); },
+       "truncated or corrupt binary STL (header says 12 triangles, file holds 5)"},
+      {"claims_2pow31.stl", [=] { return test::binaryStl(box, 1u << 31); },
+       "header says 2147483648 triangles"},
+      {"zero_triangles.stl", [=] { return test::binaryStl(TriangleMesh{}); }, "no faces"},
+      {"ascii_cut_mid_facet.stl", [=] { return test::asciiStl(box).substr(0, 700); }, "not closed"},
+      {"solid_header_binary.stl",
+       [=] {
+         std::string s = test::binaryStl(box);
+         std::memcpy(s.data(), "solid box", 9);
+         return s;
+       },
+       "", massNear(0.3 * 0.2 * 0.1)},
+      // PLY whose counts lie, in both encodings, or whose header never ends.
+      {"vertex_count_lies.ply", [] { return plyHeader("ascii", 100, 4) + kPlyTetBody; },
+       "the header says 100 vertex items"},
+      {"face_count_lies.ply", [] { return binaryPlyTet(4, 100); }, "the header says 100 face items"},
+      {"claims_4g_vertices.ply", [] { return binaryPlyTet(4294967295u, 4); },
+       "the header says 4294967295 vertex items"},
+      {"list_count_lies.ply",
+       [] {
+         return plyHeader("ascii", 4, 4) +
+                "0 0 0\n1 0 0\n0 1 0\n0 0 1\n255 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+       },
+       "the file ends in face 0 of 4"},
+      {"no_end_header.ply",
+       [] { return std::string("ply\nformat ascii 1.0\nelement vertex 4\n") + kPlyTetBody; },
+       "unknown PLY header line '0'"},
+      {"header_never_ends.ply", [] { return std::string("ply\nformat ascii 1.0\nelement vertex 4\n"); },
+       "PLY header without end_header"},
+      {"face_index_out_of_range.ply",
+       [] {
+         return plyHeader("ascii", 4, 4) + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 9\n";
+       },
+       "refers to vertex 9"},
+      // OFF whose counts lie.
+      {"vertex_count_lies.off", [] { return "OFF\n8 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n"; },
+       "the header says 8 vertices, the file ends after 6"},
+      {"binary.off", [] { return "OFF BINARY\n4 4 0\n" + std::string(64, '\0'); },
+       "binary OFF is not supported"},
+      // OBJ indices: negative past the start, overflowing, zero.
+      {"negative_index.obj", [] { return kTet + kTetFaces + "f -1 -2 -9\n"; }, "out of range"},
+      {"overflowing_index.obj",
+       [] { return kTet + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 99999999999999999999\n"; }, "out of range"},
+      {"zero_index.obj", [] { return kTet + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 0 4 3\n"; }, "out of range"},
+      // Numbers: NaN, infinities, beyond double, beyond float, and extreme but representable sizes.
+      {"nan.obj", [] { return "v 0 0 nan\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + kTetFaces; },
+       "non-finite number 'nan'"},
+      {"inf.off",
+       [] { return "OFF\n4 4 0\n0 0 0\n1 0 -inf\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n"; },
+       "non-finite number '-inf'"},
+      {"beyond_double.obj", [] { return "v 0 0 1e400\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + kTetFaces; },
+       "non-finite number '1e400'"},
+      {"nan.ply",
+       [] {
+         return plyHeader("ascii", 4, 4) +
+                "0 0 0\n1 0 0\n0 1 nan\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+       },
+       "vertex 2 has a non-finite coordinate"},
+      {"needle_1e39.obj", [] { return "v 0 0 1e39\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + kTetFaces; },
+       "degenerate faces"},
+      {"huge_1e38.obj", [=] { return test::objText(scaled(box, 1e38)); }, "", nullptr},
+      {"tiny_1e-30.obj", [=] { return test::objText(scaled(box, 1e-30)); }, "", nullptr},
+      // Faces: zero area, repeated vertices, two corners.
+      {"zero_area_face.obj", [] { return kTet + "v 0.5 0 0\n" + kTetFaces + "f 1 5 2\n"; }, "degenerate"},
+      {"repeated_vertex_face.off",
+       [] { return "OFF\n4 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 0 0 1\n"; },
+       "degenerate"},
+      {"two_corner_face.obj", [] { return kTet + kTetFaces + "f 1 2\n"; }, "fewer than 3 vertices"},
+      {"vertices_only.obj", [] { return kTet; }, "no faces"},
+      // Surfaces: open, a single triangle, coincident vertices (soup), non-manifold, coplanar, reversed.
+      {"open_box.obj",
+       [=] {
+         TriangleMesh open = box;
+         open.triangles.resize(open.triangles.size() - 2);
+         return test::objText(open);
+       },
+       "not closed"},
+      {"single_triangle.obj", [] { return "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; }, "not closed"},
+      {"coincident_vertices_soup.obj", [=] { return test::objText(soup(box)); }, "not closed"},
+      {"fin_on_a_tet.obj", [] { return kTet + "v 1 1 1\n" + kTetFaces + "f 1 2 5\n"; }, "not closed"},
+      {"two_tets_sharing_an_edge.obj",
+       [] { return kTet + "v 0 -1 0\nv 0 0 -1\n" + kTetFaces + "f 1 2 5\nf 1 6 2\nf 2 6 5\nf 1 5 6\n"; },
+       "not manifold"},
+      {"all_coplanar_two_sided.obj", [] { return "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n"; },
+       "volume"},
+      {"inside_out.obj", [=] { return test::objText(reversed(box, box.triangles.size())); }, "inside out"},
+      {"one_face_flipped.obj", [=] { return test::objText(reversed(box, 1)); }, "orient"},
+      // Self-intersecting and multi-part solids: documented results (signed volume; one object).
+      {"self_intersecting_boxes.obj",
+       [=] {
+         return test::objText(merged(box, translated(box, {0.15, 0.0, 0.0})));
+       },
+       "", massNear(2 * 0.3 * 0.2 * 0.1)},
+      {"two_separate_spheres.obj",
+       [=] {
+         return test::objText(merged(blob, translated(blob, {1.0, 0.0, 0.0})));
+       },
+       "", nullptr},
+      // Text oddities: CRLF line ends, a 4 MB comment line.
+      {"crlf.obj",
+       [=] {
+         std::string text = test::objText(box), out;
+         for (char c : text) {
+           if (c == '\n') out.push_back('\r');
+           out.push_back(c);
+         }
+         return out;
+       },
+       "", massNear(0.3 * 0.2 * 0.1)},
+      {"long_comment_line.obj", [=] { return "# " + std::string(4 << 20, 'x') + "\n" + test::objText(box); },
+       "", massNear(0.3 * 0.2 * 0.1)},
+  };
+}
+
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.file;
+}
+
+class HostileInput : public ::testing::TestWithParam<Case> {
+ protected:
+  static void SetUpTestSuite() {
+    sDir = std::make_unique<test::ScratchDir>("hostile");
+    test::ProcessResult built =
+        test::runProcess(SHAPEDB_CLI, {"build", (*sDir / "small.db").string(), "--entries", "8", "--families",
+                                       "box,ellipsoid", "--modes", "4", "--quiet"});
+    if (built.exitCode != 0) sBuildError = "shapedb build failed: " + built.err;
+  }
+  static void TearDownTestSuite() { sDir.reset(); }
+  void SetUp() override { ASSERT_TRUE(sBuildError.empty()) << sBuildError; }
+
+  static inline std::unique_ptr<test::ScratchDir> sDir;
+  static inline std::string sBuildError;
+};
+
+TEST_P(HostileInput, GivesItsDocumentedErrorOrResult) {
+  const Case& c = GetParam();
+  const auto file = *sDir / c.file;
+  test::writeFile(file, c.content());
+  const test::ProcessResult q =
+      test::runProcess(SHAPEDB_CLI, {"query", (*sDir / "small.db").string(), file.string(), "--json"},
+                       {.timeoutSeconds = 120.0});
+  // For the log (and docs/reliability.md): what each input gave.
+  std::printf("%s: exit %d, %.0f MiB, %s\n", c.file.c_str(), q.exitCode,
+              static_cast<double>(q.maxRssKiB) / 1024.0,
+              q.exitCode == 0 ? "query succeeded" : q.err.substr(0, q.err.find('\n')).c_str());
+  ASSERT_FALSE(q.timedOut) << c.file << " hung";
+  ASSERT_LT(q.exitCode, 128) << c.file << " crashed: " << q.err;
+  EXPECT_LT(q.maxRssKiB, 2 << 20) << c.file << ": peak memory " << q.maxRssKiB << " KiB";
+  if (c.message.empty()) {
+    ASSERT_EQ(q.exitCode, 0) << q.err;
+    const nlohmann::json j = nlohmann::json::parse(q.out);
+    const nlohmann::json& query = j["queries"][0];
+    EXPECT_FALSE(query["matches"].empty());
+    EXPECT_TRUE(std::isfinite(query["physics"]["mass"].get<double>()));
+    EXPECT_GT(query["physics"]["mass"].get<double>(), 0.0);
+    if (c.check) c.check(query);
+  } else {
+    EXPECT_EQ(q.exitCode, 1) << q.err;
+    EXPECT_NE(q.err.find(file.string() + ": "), std::string::npos) << "the file is not named: " << q.err;
+    EXPECT_NE(q.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << q.err;
+  }
+}
+
+std::string caseName(const ::testing::TestParamInfo<Case>& info) {
+  std::string name;
+  for (char ch : info.param.file)
+    name.push_back(std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_');
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Corpus, HostileInput, ::testing::ValuesIn(corpus()), caseName);
+
+/// A closed UV ellipsoid of 10,000,000 triangles as binary PLY (186 MB), written directly: the query
+/// must read, validate, describe and match it with a correct volume, in bounded memory.
+TEST_F(HostileInput, TenMillionTriangleMeshIsQueriedInBoundedMemory) {
+  const int slices = 2500, stacks = 2001;  // 2 · slices · (stacks − 1) = 10,000,000 triangles
+  const TriangleMesh mesh = core::makeUvEllipsoid({0.2, 0.1, 0.05}, slices, stacks);
+  ASSERT_EQ(mesh.triangles.size(), 10'000'000u);
+  const auto file = *sDir / "ten_million.ply";
+  {
+    std::ofstream out(file, std::ios::binary);
+    out << plyHeader("binary_little_endian", mesh.vertices.size(), mesh.triangles.size());
+    for (const Vec3& p : mesh.vertices) {
+      const float v[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      out.write(reinterpret_cast<const char*>(v), sizeof v);
+    }
+    for (const auto& t : mesh.triangles) {
+      const char three = 3;
+      const int f[3] = {static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2])};
+      out.write(&three, 1);
+      out.write(reinterpret_cast<const char*>(f), sizeof f);
+    }
+    ASSERT_TRUE(out.good());
+  }
+  const test::ProcessResult q =
+      test::runProcess(SHAPEDB_CLI, {"query", (*sDir / "small.db").string(), file.string(), "--json"},
+                       {.timeoutSeconds = 500.0});
+  std::filesystem::remove(file);
+  ASSERT_FALSE(q.timedOut);
+  ASSERT_EQ(q.exitCode, 0) << q.err;
+  const nlohmann::json j = nlohmann::json::parse(q.out);
+  const nlohmann::json& query = j["queries"][0];
+  EXPECT_EQ(query["triangles"], 10'000'000u);
+  const double volume = 4.0 / 3.0 * M_PI * 0.2 * 0.1 * 0.05;  // the tessellation is 1e-6 below this
+  EXPECT_NEAR(query["volume"].get<double>(), volume, 1e-5 * volume);
+  EXPECT_EQ(query["matches"][0]["family"], "ellipsoid");
+  std::printf("10M triangles: peak memory %.0f MiB\n", static_cast<double>(q.maxRssKiB) / 1024.0);
+  EXPECT_LT(q.maxRssKiB, 8 << 20) << "peak memory " << q.maxRssKiB << " KiB";
+}
+
+}  // namespace
+}  // namespace shapedb::cli
