@@ -36,6 +36,6 @@ for target in "${targets[@]}"; do
   build/fuzz/tests/fuzz/"fuzz_$target" "${dict[@]}" ${FUZZ_ARGS:-} -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$artifacts" "$corpus" "tests/fuzz/corpus/$target" \
     >"build/fuzz/$target.log" 2>&1 || { tail -60 "build/fuzz/$target.log"; exit 1; }
-  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build/fuzz/$target.log" | tr '\n' ' '
-  echo
+  # The last status line: inputs run, coverage, corpus size (and, with -fork, failures found and kept going past).
+  echo "fuzz: $target: $(grep -E '^#[0-9]+' "build/fuzz/$target.log" | tail -n 1)"
 done
