@@ -13,6 +13,13 @@ find_package(SQLite3 REQUIRED)
 find_package(ZLIB REQUIRED)  # CRC-32 of the database blobs
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
+# Optional: Bullet for the rigid-body scenario (shapedb drop). Without it, everything else builds.
+option(SHAPEDB_WITH_BULLET "Build the rigid-body scenario if Bullet (libbullet-dev) is found" ON)
+if(SHAPEDB_WITH_BULLET)
+  pkg_check_modules(BULLET QUIET IMPORTED_TARGET bullet)
+endif()
+set(SHAPEDB_HAVE_BULLET ${BULLET_FOUND})
+message(STATUS "shapedb: rigid-body scenario (Bullet): ${BULLET_FOUND}")
 
 find_path(TETGEN_INCLUDE_DIR tetgen.h REQUIRED)
 find_library(TETGEN_LIBRARY NAMES tet REQUIRED)
