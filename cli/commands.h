@@ -35,6 +35,7 @@ Command addHapticCommand(CLI::App& parent);
 Command addFractureCommand(CLI::App& parent);
 Command addBenchCommand(CLI::App& parent);
 Command addSoundCommand(CLI::App& parent);
+Command addDropCommand(CLI::App& parent);
 
 /// Loads a mesh file and fractures it; errors name the file. Shared by fracture and haptic --fracture.
 Result<volume::FractureResult> fractureMeshFile(const std::string& path,

@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
                                    addInfoCommand(app),    addAddCommand(app),      addQueryCommand(app),
                                    addHapticCommand(app),  addFractureCommand(app), addBenchCommand(app),
-                                   addSoundCommand(app)};
+                                   addSoundCommand(app),   addDropCommand(app)};
 
   try {
     app.parse(argc, argv);
