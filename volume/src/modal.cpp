@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -109,9 +110,18 @@ Result<ModalData> makeModalData(const Eigen::VectorXd& eigenvalues, const Eigen:
     zeros += std::abs(eigenvalues[i]) <= kRigidTolerance * scale ? 1 : 0;
   for (double r : rigid)
     zeros -= std::abs(r) <= kRigidTolerance * scale ? 0 : 1;
-  if (zeros != 6 || !(firstElastic > kRigidTolerance * scale))
+  if (zeros != 6 || !(firstElastic > kRigidTolerance * scale)) {
+    // Say what was found: the smallest eigenvalues against the stiffness scale.
+    char detail[160];
+    std::snprintf(detail, sizeof detail, " (smallest non-rigid: %.3g, %.3g, %.3g of the stiffness scale)",
+                  eigenvalues[0] / scale, eigenvalues.size() > 1 ? eigenvalues[1] / scale : 0.0,
+                  eigenvalues.size() > 2 ? eigenvalues[2] / scale : 0.0);
+    if (zeros == 6)
+      return Error{ErrorCode::kParse, std::string("the first non-rigid eigenvalue is not positive") + detail +
+                                          ": degenerate or inverted tets?"};
     return Error{ErrorCode::kParse, "expected six rigid modes, found " + std::to_string(zeros) +
-                                        " zero eigenvalues (is the solid in one piece?)"};
+                                        " zero eigenvalues (is the solid in one piece?)" + detail};
+  }
   ModalData data;
   data.poissonRatio = options.material.poissonRatio;
   for (std::size_t i = 0; i < 6; ++i)
