@@ -28,6 +28,12 @@ bool getMat3(ByteReader& r, core::Mat3& m) {
   return true;
 }
 
+/// Finite and at least `low`: what every stored size, weight or frequency must be. A blob whose checksum
+/// matches but whose values are not (a hostile file) is as corrupted as one whose checksum does not.
+bool finiteAtLeast(double v, double low) {
+  return std::isfinite(v) && v >= low;
+}
+
 }  // namespace
 
 std::uint32_t checksum(const void* data, std::size_t size) {
@@ -85,8 +91,10 @@ Result<core::Descriptor> decodeDescriptor(const void* data, std::size_t size) {
     r.get(d.cells[i]);
     if (hasCentroids) getVec3(r, d.centroids[i]);
     if (hasWeights) r.get(d.weights[i]);
+    if ((hasCentroids && !d.centroids[i].allFinite()) || (hasWeights && !std::isfinite(d.weights[i])))
+      return corrupted("descriptor");
   }
-  if (!r.atEnd()) return corrupted("descriptor");
+  if (!r.atEnd() || !d.moments.allFinite() || !finiteAtLeast(d.cellSize, 0.0)) return corrupted("descriptor");
   return d;
 }
 
@@ -110,7 +118,7 @@ Result<core::TetMesh> decodeTetMesh(const void* data, std::size_t size) {
   core::TetMesh mesh;
   mesh.nodes.resize(nodes);
   for (core::Vec3& p : mesh.nodes)
-    getVec3(r, p);
+    if (!getVec3(r, p) || !p.allFinite()) return corrupted("tet mesh");
   if (!r.has(tets, 16)) return corrupted("tet mesh");
   mesh.tets.resize(tets);
   for (auto& t : mesh.tets)
@@ -149,8 +157,10 @@ Result<core::ModalData> decodeModes(const void* data, std::size_t size) {
   std::uint32_t rows = 0, count = 0;
   if (!(r.get(modes.poissonRatio) && r.get(rows) && r.get(count))) return corrupted("modes");
   for (double& v : modes.rigidEigenvalues)
-    r.get(v);
-  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0) return corrupted("modes");
+    if (!r.get(v) || !std::isfinite(v)) return corrupted("modes");
+  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0 || !finiteAtLeast(modes.poissonRatio, 0.0) ||
+      modes.poissonRatio >= 0.5)
+    return corrupted("modes");
   modes.eigenvalues.resize(count);
   modes.shapes.resize(rows, count);
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -162,7 +172,9 @@ Result<core::ModalData> decodeModes(const void* data, std::size_t size) {
       r.get(q);
       modes.shapes(j, i) = q * scale;
     }
-    if (!(std::isfinite(modes.eigenvalues[i]) && modes.eigenvalues[i] > 0.0 && std::isfinite(scale)))
+    // A finite scale can still overflow against the largest 16-bit value: the shape itself must be finite.
+    if (!(std::isfinite(modes.eigenvalues[i]) && modes.eigenvalues[i] > 0.0 && std::isfinite(scale) &&
+          modes.shapes.col(i).allFinite()))
       return corrupted("modes");
   }
   if (!r.atEnd()) return corrupted("modes");
@@ -184,7 +196,9 @@ Result<core::MassProperties> decodeMassProperties(const void* data, std::size_t 
   core::MassProperties m;
   if (!(r.get(m.density) && r.get(m.volume) && r.get(m.mass) && getVec3(r, m.centerOfMass) &&
         getMat3(r, m.inertia)) ||
-      !r.atEnd())
+      !r.atEnd() || !(m.density > 0.0 && m.volume > 0.0 && m.mass > 0.0) ||
+      !(std::isfinite(m.density) && std::isfinite(m.volume) && std::isfinite(m.mass)) ||
+      !m.centerOfMass.allFinite() || !m.inertia.allFinite())
     return corrupted("mass properties");
   return m;
 }
@@ -222,8 +236,11 @@ Result<core::CollisionCompound> decodeCollision(const void* data, std::size_t si
     getVec3(r, s.halfExtents);
     r.get(s.radius);
     r.get(s.halfLength);
+    if (!s.center.allFinite() || !s.rotation.allFinite() || !s.halfExtents.allFinite() ||
+        s.halfExtents.minCoeff() < 0.0 || !finiteAtLeast(s.radius, 0.0) || !finiteAtLeast(s.halfLength, 0.0))
+      return corrupted("collision");
   }
-  if (!r.atEnd()) return corrupted("collision");
+  if (!r.atEnd() || !std::isfinite(c.coverage) || !std::isfinite(c.overshoot)) return corrupted("collision");
   return c;
 }
 
@@ -245,8 +262,9 @@ Result<core::SoundData> decodeSound(const void* data, std::size_t size) {
     return corrupted("sound");
   s.frequenciesHz.resize(count);
   for (std::uint32_t i = 0; i < count; ++i)
-    r.get(s.frequenciesHz[i]);
-  if (!r.atEnd()) return corrupted("sound");
+    if (!r.get(s.frequenciesHz[i]) || !finiteAtLeast(s.frequenciesHz[i], 0.0)) return corrupted("sound");
+  if (!r.atEnd() || !finiteAtLeast(s.damping.alpha, 0.0) || !finiteAtLeast(s.damping.beta, 0.0))
+    return corrupted("sound");
   return s;
 }
 

@@ -1,7 +1,8 @@
 // Fuzz target: the decoders of the database's blobs (io/src/codec.h), which read bytes that a damaged or
 // hostile file may hold. The first byte picks the decoder, the rest is the blob. Checked beyond "no
 // crash, no leak, no UB, no allocation the blob cannot pay for": whatever decodes re-encodes into a blob
-// that decodes again (the encoder never writes what the decoder refuses).
+// that decodes again (the encoder never writes what the decoder refuses). It found modes whose finite
+// scale times a 16-bit value overflowed to infinity: the decoders now refuse non-finite values.
 
 #include "../../io/src/codec.h"
 #include "fuzz_support.h"
