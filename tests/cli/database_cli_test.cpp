@@ -47,6 +47,22 @@ std::string dumpEntries(const std::filesystem::path& path) {
   return out;
 }
 
+/// A resumed database must hold exactly what a clean build holds; on a difference, says where (the first
+/// row that differs; blobs are hex, so cut short).
+void expectSameEntries(const std::filesystem::path& resumed, const std::filesystem::path& clean) {
+  const std::string a = dumpEntries(resumed), b = dumpEntries(clean);
+  if (a == b) return;
+  std::size_t line = 0, at = 0;
+  while (at < std::min(a.size(), b.size()) && a[at] == b[at])
+    line += a[at++] == '\n' ? 1 : 0;
+  const auto lineAt = [](const std::string& s, std::size_t from) {
+    const std::size_t begin = s.rfind('\n', from) == std::string::npos ? 0 : s.rfind('\n', from) + 1;
+    return s.substr(begin, std::min<std::size_t>(200, s.find('\n', begin) - begin));
+  };
+  ADD_FAILURE() << "the resumed database differs from the clean one at row " << line
+                << ":\n  resumed: " << lineAt(a, at) << "\n  clean:   " << lineAt(b, at);
+}
+
 std::size_t committedEntries(const std::filesystem::path& path) {
   auto store = io::Store::open(path);
   if (!store) return 0;
@@ -100,20 +116,8 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
   test::ProcessResult fresh = test::runProcess(SHAPEDB_CLI, cleanArgs);
   ASSERT_EQ(fresh.exitCode, 0) << fresh.err;
 
-  const std::string a = dumpEntries(killed), b = dumpEntries(clean);
   EXPECT_EQ(committedEntries(killed), 24u);
-  if (a != b) {
-    // Say where: the first line that differs (blobs are hex, so cut it short).
-    std::size_t line = 0, at = 0;
-    while (at < std::min(a.size(), b.size()) && a[at] == b[at])
-      line += a[at++] == '\n' ? 1 : 0;
-    const auto lineAt = [](const std::string& s, std::size_t from) {
-      const std::size_t begin = s.rfind('\n', from) == std::string::npos ? 0 : s.rfind('\n', from) + 1;
-      return s.substr(begin, std::min<std::size_t>(200, s.find('\n', begin) - begin));
-    };
-    ADD_FAILURE() << "the resumed database differs from the clean one at row " << line
-                  << ":\n  resumed: " << lineAt(a, at) << "\n  clean:   " << lineAt(b, at);
-  }
+  expectSameEntries(killed, clean);
 
   // A resume that asks for other parameters is refused, and says why.
   test::ProcessResult conflict =
@@ -149,7 +153,7 @@ TEST(BuildCli, AFullDiskFailsClearlyKeepsWhatWasCommittedAndTheBuildResumes) {
   cleanBuild.insert(cleanBuild.end(), args.begin(), args.end());
   ASSERT_EQ(test::runProcess(SHAPEDB_CLI, cleanBuild).exitCode, 0);
   EXPECT_EQ(committedEntries(full), 24u);
-  EXPECT_TRUE(dumpEntries(full) == dumpEntries(clean)) << "the resumed database differs from a clean build";
+  expectSameEntries(full, clean);
 }
 
 TEST(BuildCli, AReadOnlyDatabaseIsQueriedAndWritesAreRefusedWithNothingChanged) {
