@@ -24,7 +24,9 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
-scripts/setup.sh fuzz
+fuzzers=()
+for target in "${targets[@]}"; do fuzzers+=("fuzz_$target"); done
+scripts/setup.sh fuzz "${fuzzers[@]}"
 
 for target in "${targets[@]}"; do
   corpus="build/fuzz/corpus/$target" artifacts="build/fuzz/artifacts/$target/"

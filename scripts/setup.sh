@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Installs shapedb's Debian 12 packages (only those missing; silent when all are there) and builds one
-# CMake preset (default: release). Usage: scripts/setup.sh [release|debug|asan|tsan|fuzz]
+# CMake preset (default: release), or only the given targets of it.
+# Usage: scripts/setup.sh [release|debug|asan|tsan|fuzz] [TARGET...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
+shift || true
+targets=("$@")
 
 packages=(
   build-essential cmake ninja-build pkg-config clang-format
@@ -26,4 +29,8 @@ fi
 echo "setup: building preset '$preset' in build/$preset"
 mkdir -p build
 cmake --preset "$preset" >"build/configure-$preset.log" 2>&1 || { cat "build/configure-$preset.log"; exit 1; }
-cmake --build --preset "$preset"
+if ((${#targets[@]})); then
+  cmake --build "build/$preset" --target "${targets[@]}"
+else
+  cmake --build --preset "$preset"
+fi
