@@ -133,13 +133,8 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
   // Everything raised together so that its lowest collision point is at --height.
   double lowest = std::numeric_limits<double>::infinity();
   for (const haptics::RigidBody& b : bodies)
-    for (const core::CollisionShape& s : b.collision.shapes) {
-      const core::Vec3 extent =
-          s.type == core::CollisionShape::Type::kBox
-              ? core::Vec3(s.rotation.row(2).cwiseAbs().transpose().cwiseProduct(s.halfExtents))
-              : core::Vec3(0, 0, s.radius + std::abs(s.rotation(2, 2)) * s.halfLength);
-      lowest = std::min(lowest, s.center.z() - extent.sum());
-    }
+    for (const core::CollisionShape& s : b.collision.shapes)
+      lowest = std::min(lowest, haptics::lowestPoint(s));
   haptics::DropOptions options;
   options.lift = o.height - lowest;
   options.seconds = o.seconds;

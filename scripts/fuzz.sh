@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds the fuzz preset (Clang 14, libFuzzer, ASan+UBSan) and runs each fuzz target for SECONDS,
-# one after another, starting from its seed corpus (tests/fuzz/corpus/<target>, never written to).
+# Builds the fuzz preset (Clang 14, libFuzzer, ASan+UBSan; scripts/setup.sh installs Clang if missing) and
+# runs each fuzz target for SECONDS, one after another, starting from its seed corpus (tests/fuzz/corpus/<target>, never written to).
 # New inputs go to build/fuzz/corpus/<target>; a failing input to build/fuzz/artifacts/<target>/ and the
 # script fails. Keep a failing input as a regression test by copying it into tests/fuzz/corpus/<target>/.
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   (default: 30 s; obj ply off stl blob database)
@@ -12,18 +12,6 @@ shift || true
 targets=("$@")
 ((${#targets[@]})) || targets=(obj ply off stl blob database)
 
-packages=(clang-14 libclang-rt-14-dev)
-missing=()
-for package in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
-done
-if ((${#missing[@]})); then
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  echo "fuzz: installing ${missing[*]}"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
 fuzzers=()
 for target in "${targets[@]}"; do fuzzers+=("fuzz_$target"); done
 scripts/setup.sh fuzz "${fuzzers[@]}"

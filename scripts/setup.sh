@@ -14,6 +14,8 @@ packages=(
   libopenmesh-dev libspectra-dev libgtest-dev googletest libbenchmark-dev libcli11-dev
   nlohmann-json3-dev libsqlite3-dev libstb-dev zlib1g-dev sqlite3 libbullet-dev
 )
+# The fuzz preset builds with Clang and links libFuzzer.
+[ "$preset" = fuzz ] && packages+=(clang-14 libclang-rt-14-dev)
 missing=()
 for package in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")

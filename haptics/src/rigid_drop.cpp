@@ -38,7 +38,8 @@ core::Mat4 fromBt(const btTransform& t) {
   return m;
 }
 
-/// The lowest z of a shape (world frame at the start) once moved by `pose`: exact for each solid.
+}  // namespace
+
 double lowestPoint(const core::CollisionShape& s, const core::Mat4& pose) {
   const core::Mat3 r = pose.topLeftCorner<3, 3>();
   const core::Vec3 center = r * s.center + pose.topRightCorner<3, 1>();
@@ -53,6 +54,8 @@ double lowestPoint(const core::CollisionShape& s, const core::Mat4& pose) {
   }
   return center.z();
 }
+
+namespace {
 
 /// A body's frame: its centre of mass and principal axes (right-handed), and the principal moments.
 struct PrincipalFrame {

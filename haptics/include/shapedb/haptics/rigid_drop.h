@@ -49,6 +49,9 @@ struct DropReport {
   std::size_t atRest = 0;                       ///< bodies at rest at the end
 };
 
+/// The lowest z of a collision shape moved by `pose` (world from start): exact for each solid.
+double lowestPoint(const core::CollisionShape& shape, const core::Mat4& pose = core::Mat4::Identity());
+
 /// Steps the bodies in Bullet's discrete dynamics world with a static floor plane. Each body's frame is
 /// its centre of mass and principal axes; its compound's spheres, boxes and capsules are placed in it.
 /// Deterministic: the same bodies and options give the same report. Errors: kInvalidArgument for a
