@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 
@@ -74,7 +75,8 @@ Eigen::VectorXd AdaptedPhysics::dampingRatios() const {
 
 Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& query,
                              const MassProperties& queryMass, const Mat3& orientation,
-                             const Material& material, const RayleighDamping& damping) {
+                             const Material& material, const RayleighDamping& damping,
+                             const StretchBasis* stretch) {
   if (Status valid = validateMaterial(material); !valid) return valid.error();
   const std::size_t nodes = entry.tetMesh.nodeCount();
   if (entry.modes.shapes.rows() != static_cast<Eigen::Index>(3 * nodes) ||
@@ -109,16 +111,36 @@ Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& que
   out.entryMassProperties.inertia =
       P.rotation * e.inertia * P.rotation.transpose() * (rho / e.density) * std::pow(L, 5);
 
+  // The entry's modes, or those of the entry stretched to the query's second moments (in the entry's
+  // axes: the query's canonical frame is Oᵀ times the entry's).
+  const Eigen::VectorXd* eigenvalues = &entry.modes.eigenvalues;
+  const Eigen::MatrixXd* shapes = &entry.modes.shapes;
+  std::optional<StretchedModes> stretched;
+  if (stretch) {
+    const Mat3 target =
+        orientation * secondMomentsFromInertia(query.canonicalMoments) * orientation.transpose();
+    Result<StretchedModes> s = stretchModes(*stretch, entry.modes, entry.tetMesh,
+                                            momentMatchingStretch(stretch->secondMoments, target));
+    if (s) {
+      stretched = std::move(s).value();
+      eigenvalues = &stretched->eigenvalues;
+      shapes = &stretched->shapes;
+      out.stretch = stretched->stretch;
+    } else {
+      out.warnings.push_back("stretch correction not applied: " + s.error().message);
+    }
+  }
+
   // K scales with E·L, M with ρ·L³: λ = (E / ρL²) λ'. φ keeps φᵀMφ = 1 with φ = R φ' / sqrt(ρL³).
-  out.eigenvalues = entry.modes.eigenvalues * (material.youngsModulus / (rho * L * L));
+  out.eigenvalues = *eigenvalues * (material.youngsModulus / (rho * L * L));
   const double shapeScale = 1.0 / std::sqrt(rho * L * L * L);
-  const Eigen::Index m = entry.modes.shapes.cols();
-  out.modeShapes.resize(entry.modes.shapes.rows(), m);
+  const Eigen::Index m = shapes->cols();
+  out.modeShapes.resize(shapes->rows(), m);
   const Mat3 R = P.rotation * shapeScale;
   for (Eigen::Index j = 0; j < m; ++j)
     for (std::size_t i = 0; i < nodes; ++i)
       out.modeShapes.col(j).segment<3>(3 * static_cast<Eigen::Index>(i)) =
-          R * entry.modes.shapes.col(j).segment<3>(3 * static_cast<Eigen::Index>(i));
+          R * shapes->col(j).segment<3>(3 * static_cast<Eigen::Index>(i));
 
   out.collision = entry.collision;
   for (CollisionShape& s : out.collision.shapes) {

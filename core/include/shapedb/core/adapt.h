@@ -14,6 +14,7 @@
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
 #include <shapedb/core/spatial.h>
+#include <shapedb/core/stretch.h>
 #include <shapedb/core/types.h>
 
 namespace shapedb::core {
@@ -56,8 +57,12 @@ struct AdaptedPhysics {
   /// The entry's tets as placed: what the retrieved data assume. Compare with massProperties.
   MassProperties entryMassProperties;
   Eigen::VectorXd eigenvalues;  ///< ω², (rad/s)², ascending: ω = sqrt(E/ρ) ω' / L
+  /// The factors by which the entry was stretched along its canonical axes to take the query's second
+  /// moments before its modes were adapted (stretch correction; (1, 1, 1) without it). The tet mesh and
+  /// the collision compound are not stretched.
+  Vec3 stretch = Vec3::Ones();
   /// 3·nodes × modes, in the query's frame, M-orthonormal for the mass matrix of tetMesh at the
-  /// material's density: φ = R φ' / sqrt(ρ L³).
+  /// material's density: φ = R φ' / sqrt(ρ L³), φ' the entry's modes (stretched ones with the correction).
   Eigen::MatrixXd modeShapes;
   CollisionCompound collision;  ///< shapes in the query's frame; coverage and overshoot are the entry's
   RayleighDamping damping;      ///< the database's, applied to the adapted frequencies
@@ -70,11 +75,15 @@ struct AdaptedPhysics {
 /// Adapts `entry` to a query with normalization `query` (its exact mass properties at unit density in
 /// `queryMass`) matched in orientation `orientation` (Match::orientation). A material whose Poisson
 /// ratio differs from the database's by more than 0.01 adds a warning: the mode shapes and the ratios
-/// of the frequencies are those of the database's ratio. Errors: validateMaterial's; kInvalidArgument for
-/// an entry whose modes do not fit its tet mesh.
+/// of the frequencies are those of the database's ratio. With `stretch` (computeStretchBasis of the
+/// entry), the modes are those of the entry stretched along its canonical axes until its second moments
+/// equal the query's (stretch.h); a stretch the correction cannot take leaves the modes uncorrected and
+/// adds a warning. Errors: validateMaterial's; kInvalidArgument for an entry whose modes do not fit its
+/// tet mesh.
 Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& query,
                              const MassProperties& queryMass, const Mat3& orientation,
-                             const Material& material, const RayleighDamping& damping);
+                             const Material& material, const RayleighDamping& damping,
+                             const StretchBasis* stretch = nullptr);
 
 /// Linking (paper eq. 7): per surface vertex, the adapted tet that holds it and its four barycentric
 /// weights (≥ 0, summing to 1). A vertex outside every tet is tied to the closest point of the tet
