@@ -231,10 +231,19 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
 
 namespace {
 
-/// What the cache keeps per entry: its physical data and the locator built on its tets.
+/// What the cache keeps per entry: its physical data, the locator built on its tets, and the stretch
+/// basis of its modes, computed by the first query that wants it.
 struct CachedEntry {
   core::PhysicalData data;
   core::TetLocator locator;
+  const core::StretchBasis& stretchBasis() const {
+    std::call_once(stretchOnce, [&] { stretch = core::computeStretchBasis(data.tetMesh, data.modes); });
+    return stretch;
+  }
+
+ private:
+  mutable std::once_flag stretchOnce;
+  mutable core::StretchBasis stretch;
 };
 
 using Describers = std::array<std::unique_ptr<volume::Describer>, 3>;
@@ -429,7 +438,8 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     t = Clock::now();
     auto adapted =
         core::adapt(best.data, out.normalization, out.massProperties, out.matches.front().match.orientation,
-                    options.material, parameters().entry.damping);
+                    options.material, parameters().entry.damping,
+                    options.stretchCorrection ? &best.stretchBasis() : nullptr);
     if (!adapted) return adapted.error();
     out.physics = std::move(adapted).value();
     out.times.adapt = microsecondsSince(t);

@@ -73,6 +73,19 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   for (const char* stage : {"describe", "search", "fetch", "adapt", "link", "total"})
     EXPECT_GE(b["timing_us"][stage].get<double>(), 0.0) << stage;
   EXPECT_EQ(j["queries"][1]["matches"][0]["family"], "cylinder");
+  // Scaled uniformly by default; with --stretch, the matched box entry takes the query's proportions.
+  EXPECT_EQ(p["stretch"], nlohmann::json::parse("[1.0, 1.0, 1.0]"));
+  test::ProcessResult stretched = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), box.string(), "--material", "aluminium", "--json", "--stretch"});
+  ASSERT_EQ(stretched.exitCode, 0) << stretched.err;
+  const nlohmann::json sj = nlohmann::json::parse(stretched.out);
+  const nlohmann::json& sp = sj["queries"][0]["physics"];
+  ASSERT_EQ(sp["stretch"].size(), 3u);
+  for (const auto& a : sp["stretch"])
+    EXPECT_GT(a.get<double>(), 0.0);
+  EXPECT_NE(sp["stretch"], p["stretch"]);  // three box entries: none is 3:2:1
+  EXPECT_EQ(sp["mass"], p["mass"]);
+  EXPECT_NE(sp["frequencies_hz"], p["frequencies_hz"]);
 
   // Files beside the queries: two PNGs (one per mesh), and OBJs of the adapted volume and compound.
   for (const char* name : {"side-1.png", "side-2.png"})

@@ -74,6 +74,12 @@ TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
   EXPECT_EQ(self.match, entry.name);
   EXPECT_LT(self.maxFrequencyError, 0.03);
   EXPECT_GT(self.overlap.iou, 0.8);  // the compound's own fit to its shape
+  // Its proportions are its own: stretched or scaled uniformly, the same frequencies.
+  const MethodEvaluation& stretched = (*evaluations)[0].methods[5];
+  EXPECT_EQ(stretched.method, EvaluationMethod::kCentroidVoxelStretched);
+  EXPECT_EQ(stretched.match, self.match);
+  EXPECT_NEAR(stretched.firstFrequencyError, self.firstFrequencyError, 1e-3);
+  EXPECT_GT(stretched.queryMicros, self.queryMicros);
   // The box is its own inertia-equivalent box, and the ellipsoid nearly its own ellipsoid.
   const MethodEvaluation& box = (*evaluations)[1].methods[4];
   EXPECT_LT(box.maxFrequencyError, 0.03);

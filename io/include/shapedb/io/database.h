@@ -76,7 +76,12 @@ struct QueryOptions {
   /// Fetch the best match's physical data, adapt it to the query (size, frame, material) and link the
   /// query's vertices to its tets. false: matching only.
   bool adapt = true;
-  bool link = true;      ///< with adapt
+  bool link = true;  ///< with adapt
+  /// With adapt: the entry's modes stretched to the query's second moments before they are adapted
+  /// (core/stretch.h). Off by default: it costs ~1 ms a query (a 3m × 3m eigenproblem) and, the first
+  /// time an entry is adapted, its stretch basis (~25 ms; cached with its data), and on the benchmark
+  /// it narrows the worst errors more than the median (docs/architecture.md).
+  bool stretchCorrection = false;
   bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
   core::FidelityOptions fidelityOptions;
 };

@@ -24,12 +24,13 @@ namespace shapedb::io {
 
 /// What supplies a shape's physical data: the top-1 match of each descriptor, adapted (the method), or
 /// the inertia-equivalent solid ellipsoid (the precomputed sound banks of Zheng & James 2010, at their
-/// best: the exact ellipsoid rather than the nearest precomputed one) or box.
-enum class EvaluationMethod { kMoment, kVoxel, kCentroidVoxel, kEllipsoid, kBox };
-inline constexpr std::array<EvaluationMethod, 5> kEvaluationMethods{
-    EvaluationMethod::kMoment, EvaluationMethod::kVoxel, EvaluationMethod::kCentroidVoxel,
-    EvaluationMethod::kEllipsoid, EvaluationMethod::kBox};
-/// "moment", "voxel", "centroid-voxel", "ellipsoid", "box".
+/// best: the exact ellipsoid rather than the nearest precomputed one) or box; and the centroid-voxel
+/// match adapted with the stretch correction (core/stretch.h; its time added to the query's).
+enum class EvaluationMethod { kMoment, kVoxel, kCentroidVoxel, kEllipsoid, kBox, kCentroidVoxelStretched };
+inline constexpr std::array<EvaluationMethod, 6> kEvaluationMethods{
+    EvaluationMethod::kMoment,    EvaluationMethod::kVoxel, EvaluationMethod::kCentroidVoxel,
+    EvaluationMethod::kEllipsoid, EvaluationMethod::kBox,   EvaluationMethod::kCentroidVoxelStretched};
+/// "moment", "voxel", "centroid-voxel", "ellipsoid", "box", "centroid-voxel-stretched".
 const char* toString(EvaluationMethod method);
 
 struct MethodEvaluation {
