@@ -2,9 +2,14 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <fcntl.h>
 #include <fstream>
+#include <memory>
 #include <random>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <thread>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -31,20 +36,54 @@ BuildOptions smallBuild(std::size_t entries, std::vector<volume::Family> familie
   return options;
 }
 
+/// The suite's database, built once per test binary and shared by the suite's ctest processes (each
+/// test runs in a process of its own, and the build is most of their time under the sanitizers): beside
+/// the binary, named after its size and modification time, built under a file lock by the first process
+/// that wants it; databases of earlier binaries are removed then.
+Result<std::filesystem::path> suiteDatabase() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  struct stat st {};
+  if (ec || ::stat(exe.c_str(), &st) != 0) return Error{ErrorCode::kIo, "cannot find the test binary"};
+  const std::string name = "small-" + std::to_string(st.st_size) + "-" + std::to_string(st.st_mtim.tv_sec) +
+                           "." + std::to_string(st.st_mtim.tv_nsec) + ".db";
+  const std::filesystem::path dir = exe.parent_path() / "test-cache";
+  std::filesystem::create_directories(dir, ec);
+  const int lock = ::open((dir / "lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+  if (lock < 0) return Error{ErrorCode::kIo, (dir / "lock").string() + ": cannot open"};
+  const std::unique_ptr<int, void (*)(int*)> unlock(new int(lock), [](int* fd) {
+    ::close(*fd);  // releases the lock
+    delete fd;
+  });
+  if (::flock(lock, LOCK_EX) != 0) return Error{ErrorCode::kIo, (dir / "lock").string() + ": cannot lock"};
+  const std::filesystem::path path = dir / name;
+  if (std::filesystem::exists(path)) return path;
+  for (const auto& old : std::filesystem::directory_iterator(dir))
+    if (old.path().filename() != "lock") std::filesystem::remove(old.path(), ec);
+  const std::filesystem::path building = dir / (name + ".building");
+  const auto families = volume::generatedFamilies();
+  auto report = buildDatabase(building, smallBuild(3 * families.size(), {families.begin(), families.end()}));
+  if (!report) return report.error();
+  if (report->built != 3 * families.size() || report->failed != 0)
+    return Error{ErrorCode::kInvalidArgument, std::to_string(report->built) + " entries built, " +
+                                                  std::to_string(report->failed) + " failed; expected " +
+                                                  std::to_string(3 * families.size()) + " and 0"};
+  std::filesystem::rename(building, path, ec);
+  if (ec) return Error{ErrorCode::kIo, path.string() + ": " + ec.message()};
+  return path;
+}
+
 /// One database for the suite: 3 entries of each generated family. A build that fails fails every test
 /// (an assertion in SetUpTestSuite would make GoogleTest skip them, and ctest report them as skipped).
 class SmallDatabase : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     sDir = new test::ScratchDir("database");
-    sPath = sDir->path() / "small.db";
-    const auto families = volume::generatedFamilies();
-    auto report = buildDatabase(sPath, smallBuild(3 * families.size(), {families.begin(), families.end()}));
-    if (!report)
-      sBuildError = report.error().message;
-    else if (report->built != 3 * families.size() || report->failed != 0)
-      sBuildError = std::to_string(report->built) + " entries built, " + std::to_string(report->failed) +
-                    " failed; expected " + std::to_string(3 * families.size()) + " and 0";
+    auto path = suiteDatabase();
+    if (path)
+      sPath = *path;
+    else
+      sBuildError = path.error().message;
   }
   void SetUp() override { ASSERT_TRUE(sBuildError.empty()) << "the suite's database: " << sBuildError; }
   static void TearDownTestSuite() {
