@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the fuzz preset (Clang 14, libFuzzer, ASan+UBSan; scripts/setup.sh installs Clang if missing) and
-# runs each fuzz target for SECONDS, one after another, starting from its seed corpus (tests/fuzz/corpus/<target>, never written to).
+# Builds the fuzz preset (Clang 14, libFuzzer, ASan+UBSan; scripts/setup.sh installs Clang if missing)
+# and runs each fuzz target for SECONDS, one after another, starting from its seed corpus
+# (tests/fuzz/corpus/<target>, never written to).
 # New inputs go to build/fuzz/corpus/<target>; a failing input to build/fuzz/artifacts/<target>/ and the
 # script fails. Keep a failing input as a regression test by copying it into tests/fuzz/corpus/<target>/.
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   (default: 30 s; obj ply off stl blob database)

@@ -118,7 +118,7 @@ Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& que
   std::optional<StretchedModes> stretched;
   if (stretch) {
     const Mat3 target =
-        orientation * secondMomentsFromInertia(query.canonicalMoments) * orientation.transpose();
+        orientation * covarianceFromInertia(query.canonicalMoments.asDiagonal()) * orientation.transpose();
     Result<StretchedModes> s = stretchModes(*stretch, entry.modes, entry.tetMesh,
                                             momentMatchingStretch(stretch->secondMoments, target));
     if (s) {

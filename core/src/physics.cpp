@@ -37,6 +37,19 @@ Status validateTetMesh(const TetMesh& mesh) {
   return Ok{};
 }
 
+TetGradients tetGradients(const TetMesh& mesh, std::size_t t) {
+  const auto& tet = mesh.tets[t];
+  // Rows of the inverse of [x_i − x_0] give ∇N_1..3; ∇N_0 = −Σ.
+  Mat3 edges;
+  for (int k = 0; k < 3; ++k)
+    edges.col(k) = mesh.nodes[tet[static_cast<std::size_t>(k + 1)]] - mesh.nodes[tet[0]];
+  TetGradients out;
+  out.volume = edges.determinant() / 6.0;
+  out.gradients.rightCols<3>() = edges.inverse().transpose();
+  out.gradients.col(0) = -out.gradients.rightCols<3>().rowwise().sum();
+  return out;
+}
+
 MassProperties computeTetMassProperties(const TetMesh& mesh, double density) {
   // Integrals about a reference point inside the mesh's span, for round-off.
   Vec3 ref = Vec3::Zero();

@@ -32,19 +32,14 @@ StretchBasis computeStretchBasis(const TetMesh& mesh, const ModalData& modes) {
     x.resize(tets, m);
   StretchBasis basis;
   basis.firstMoments.setZero(9, m);
-  double totalVolume = 0.0;
-  Vec3 firstMoment = Vec3::Zero();
+  const MassProperties tetMass = computeTetMassProperties(mesh);
+  basis.centroid = tetMass.centerOfMass;
+  basis.secondMoments = covarianceFromInertia(tetMass.inertia);
   std::vector<Eigen::Triplet<double>> massTriplets;
   massTriplets.reserve(static_cast<std::size_t>(16 * tets));
   for (Eigen::Index t = 0; t < tets; ++t) {
     const auto& tet = mesh.tets[static_cast<std::size_t>(t)];
-    Mat3 edges;
-    for (int k = 0; k < 3; ++k)
-      edges.col(k) = mesh.nodes[tet[static_cast<std::size_t>(k + 1)]] - mesh.nodes[tet[0]];
-    const double volume = edges.determinant() / 6.0;
-    Eigen::Matrix<double, 3, 4> grad;
-    grad.rightCols<3>() = edges.inverse().transpose();
-    grad.col(0) = -grad.rightCols<3>().rowwise().sum();
+    const auto [grad, volume] = tetGradients(mesh, static_cast<std::size_t>(t));
     const double w = std::sqrt(volume);
 
     Eigen::Matrix<double, 3, 4> x;  // node positions, columns
@@ -52,9 +47,6 @@ StretchBasis computeStretchBasis(const TetMesh& mesh, const ModalData& modes) {
       x.col(a) = mesh.nodes[tet[static_cast<std::size_t>(a)]];
     const Vec3 xSum = x.rowwise().sum();
     // ∫ f g over a linear tet = V/20 (Σ f_i g_i + Σ f_i Σ g_i): the consistent mass.
-    basis.secondMoments += volume / 20.0 * (x * x.transpose() + xSum * xSum.transpose());
-    totalVolume += volume;
-    firstMoment += volume / 4.0 * xSum;
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b)
         massTriplets.emplace_back(tet[static_cast<std::size_t>(a)], tet[static_cast<std::size_t>(b)],
@@ -74,8 +66,6 @@ StretchBasis computeStretchBasis(const TetMesh& mesh, const ModalData& modes) {
         }
     }
   }
-  basis.centroid = firstMoment / totalVolume;
-  basis.secondMoments -= totalVolume * basis.centroid * basis.centroid.transpose();
 
   // The bilinear form λ div u div v + μ Σ_ij (∂_i u_j ∂_i v_j + ∂_i u_j ∂_j v_i), ∂_i → g_i ∂_i, for
   // u and v each one displacement component of a mode.
@@ -200,11 +190,6 @@ Result<StretchedModes> stretchModes(const StretchBasis& basis, const ModalData& 
 
 Vec3 momentMatchingStretch(const Mat3& body, const Mat3& target) {
   return (target.diagonal().array() / body.diagonal().array()).sqrt().matrix();
-}
-
-Mat3 secondMomentsFromInertia(const Vec3& moments) {
-  const double half = 0.5 * moments.sum();
-  return (Vec3::Constant(half) - moments).asDiagonal();
 }
 
 }  // namespace shapedb::core

@@ -148,9 +148,11 @@ TEST(Stretch, MomentMatchingStretchGivesTheTargetsSecondMoments) {
   const core::Mat3 target = Vec3(0.03, 0.04, 0.2).asDiagonal();
   const Vec3 a = core::momentMatchingStretch(body, target);
   EXPECT_LT((a.asDiagonal() * body * a.asDiagonal() - target).norm(), 1e-15);
-  // A box of sides 1, 2, 3 (volume 6): ∫x² = V·1²/12, from its principal moments.
-  const Vec3 inertia = 6.0 / 12.0 * Vec3(4 + 9, 1 + 9, 1 + 4);
-  EXPECT_LT((core::secondMomentsFromInertia(inertia).diagonal() - 6.0 / 12.0 * Vec3(1, 4, 9)).norm(), 1e-14);
+  // A box of sides 1, 2, 3 (volume 6): ∫x² = V·1²/12, from its principal moments, and back.
+  const core::Mat3 inertia = (6.0 / 12.0 * Vec3(4 + 9, 1 + 9, 1 + 4)).asDiagonal();
+  const core::Mat3 covariance = core::covarianceFromInertia(inertia);
+  EXPECT_LT((covariance - core::Mat3((6.0 / 12.0 * Vec3(1, 4, 9)).asDiagonal())).norm(), 1e-14);
+  EXPECT_LT((core::inertiaFromCovariance(covariance) - inertia).norm(), 1e-14);
 }
 
 TEST(Stretch, BadStretchOrMismatchedBasisIsAnError) {

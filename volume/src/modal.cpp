@@ -158,15 +158,7 @@ FemMatrices assembleFem(const TetMesh& mesh, const FemMaterial& material) {
   mTriplets.reserve(mesh.tetCount() * 48);
   for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
     const auto& tet = mesh.tets[t];
-    // Shape-function gradients: rows of the inverse of [x_i − x_0] give ∇N_1..3; ∇N_0 = −Σ.
-    Eigen::Matrix3d edges;
-    for (int k = 0; k < 3; ++k)
-      edges.col(k) = mesh.nodes[tet[static_cast<std::size_t>(k + 1)]] - mesh.nodes[tet[0]];
-    const double volume = edges.determinant() / 6.0;
-    const Eigen::Matrix3d inv = edges.inverse();
-    Eigen::Matrix<double, 3, 4> grad;
-    grad.rightCols<3>() = inv.transpose();
-    grad.col(0) = -grad.rightCols<3>().rowwise().sum();
+    const auto [grad, volume] = core::tetGradients(mesh, t);
     Eigen::Matrix<double, 6, 12> b = Eigen::Matrix<double, 6, 12>::Zero();
     for (int a = 0; a < 4; ++a) {
       const double gx = grad(0, a), gy = grad(1, a), gz = grad(2, a);

@@ -53,5 +53,9 @@ std::vector<double> vertexAreaWeights(const TriangleMesh& mesh);
 inline Mat3 inertiaFromCovariance(const Mat3& covariance) {
   return covariance.trace() * Mat3::Identity() - covariance;
 }
+/// The inverse: C = tr(I)/2·Id − I (tr(I) = 2 tr(C)).
+inline Mat3 covarianceFromInertia(const Mat3& inertia) {
+  return 0.5 * inertia.trace() * Mat3::Identity() - inertia;
+}
 
 }  // namespace shapedb::core

@@ -30,6 +30,14 @@ struct TetMesh {
 /// Signed volume of tet t: det[b−a, c−a, d−a] / 6.
 double tetVolume(const TetMesh& mesh, std::size_t t);
 
+/// Linear shape functions of tet t: the gradients of N_0..N_3 (columns, constant over the tet) and the
+/// signed volume.
+struct TetGradients {
+  Eigen::Matrix<double, 3, 4> gradients;
+  double volume = 0.0;
+};
+TetGradients tetGradients(const TetMesh& mesh, std::size_t t);
+
 /// Checks indices, finiteness and that every tet has positive volume (relative to the mesh's scale).
 /// Errors: kEmptyMesh, kIndexOutOfRange, kNonFinite, kDegenerateFace (a flat or inverted tet).
 Status validateTetMesh(const TetMesh& mesh);

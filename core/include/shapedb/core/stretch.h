@@ -43,7 +43,8 @@ struct StretchBasis {
   std::array<Eigen::MatrixXd, 3> mass;
   /// ∫ x_a φ_b dV (unit density) of each mode: row 3a + b, column = mode.
   Eigen::Matrix<double, 9, Eigen::Dynamic> firstMoments;
-  /// The tet mesh's centre of mass (≈ the origin of the canonical frame) and ∫ (x − c)(x − c)ᵀ dV.
+  /// The tet mesh's centre of mass (≈ the origin of the canonical frame) and ∫ (x − c)(x − c)ᵀ dV,
+  /// from computeTetMassProperties.
   Vec3 centroid = Vec3::Zero();
   Mat3 secondMoments = Mat3::Zero();
   std::size_t modeCount() const { return static_cast<std::size_t>(firstMoments.cols()); }
@@ -73,9 +74,5 @@ Result<StretchedModes> stretchModes(const StretchBasis& basis, const ModalData& 
 /// The per-axis stretch that gives a body with second moments `body` (∫ x xᵀ dV, its own principal
 /// frame) those of `target` along the same axes: a_k = sqrt(target_kk / body_kk).
 Vec3 momentMatchingStretch(const Mat3& body, const Mat3& target);
-
-/// ∫ x xᵀ dV (unit density) about the centre of mass, in the principal frame, of a body with principal
-/// moments of inertia `moments`: σ_a = (I_b + I_c − I_a) / 2 on the diagonal.
-Mat3 secondMomentsFromInertia(const Vec3& moments);
 
 }  // namespace shapedb::core
