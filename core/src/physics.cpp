@@ -37,17 +37,21 @@ Status validateTetMesh(const TetMesh& mesh) {
   return Ok{};
 }
 
-TetGradients tetGradients(const TetMesh& mesh, std::size_t t) {
-  const auto& tet = mesh.tets[t];
+TetGradients tetGradients(const std::array<Vec3, 4>& corners) {
   // Rows of the inverse of [x_i − x_0] give ∇N_1..3; ∇N_0 = −Σ.
   Mat3 edges;
   for (int k = 0; k < 3; ++k)
-    edges.col(k) = mesh.nodes[tet[static_cast<std::size_t>(k + 1)]] - mesh.nodes[tet[0]];
+    edges.col(k) = corners[static_cast<std::size_t>(k + 1)] - corners[0];
   TetGradients out;
   out.volume = edges.determinant() / 6.0;
   out.gradients.rightCols<3>() = edges.inverse().transpose();
   out.gradients.col(0) = -out.gradients.rightCols<3>().rowwise().sum();
   return out;
+}
+
+TetGradients tetGradients(const TetMesh& mesh, std::size_t t) {
+  const auto& tet = mesh.tets[t];
+  return tetGradients({mesh.nodes[tet[0]], mesh.nodes[tet[1]], mesh.nodes[tet[2]], mesh.nodes[tet[3]]});
 }
 
 MassProperties computeTetMassProperties(const TetMesh& mesh, double density) {

@@ -1,4 +1,7 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -39,6 +42,120 @@ TEST(Fem, StiffnessAnnihilatesRigidMotionsAndMassIntegratesVolume) {
   for (Eigen::Index i = 0; i < n; ++i)
     ux[3 * i] = 1.0;
   EXPECT_NEAR(ux.dot(fem.mass * ux), 2.0, 1e-12);
+}
+
+TEST(Fem, QuadraticReferenceMassIsTheClosedForm) {
+  // ∫ N_a N_b dV / V of the 10-node tet, times 420: corners 6 (same) and 1 (two corners), corner and
+  // edge −4 (the edge ends at the corner) or −6, edges 32 (same), 16 (sharing a corner), 8 (opposite).
+  // (The classic table; its entries sum to 420: ∫ (Σ N)² = V.)
+  const std::array<std::array<int, 2>, 6> edges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+  const auto touches = [&](int e, int corner) { return edges[e][0] == corner || edges[e][1] == corner; };
+  const Eigen::Matrix<double, 10, 10>& m = quadraticReferenceMass();
+  for (int a = 0; a < 10; ++a)
+    for (int b = 0; b < 10; ++b) {
+      double expected = 0.0;
+      if (a < 4 && b < 4) {
+        expected = a == b ? 6.0 : 1.0;
+      } else if (a < 4 || b < 4) {
+        const int corner = std::min(a, b), edge = std::max(a, b) - 4;
+        expected = touches(edge, corner) ? -4.0 : -6.0;
+      } else {
+        const int e = a - 4, f = b - 4;
+        const bool shared = touches(f, edges[e][0]) || touches(f, edges[e][1]);
+        expected = e == f ? 32.0 : shared ? 16.0 : 8.0;
+      }
+      EXPECT_NEAR(420.0 * m(a, b), expected, 1e-12) << a << ", " << b;
+    }
+  EXPECT_NEAR(m.sum(), 1.0, 1e-14);
+}
+
+/// Displacements of every node of either mesh from a function of position.
+template <typename Field>
+Eigen::VectorXd interpolate(const std::vector<Vec3>& nodes, Field field) {
+  Eigen::VectorXd u(3 * static_cast<Eigen::Index>(nodes.size()));
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    u.segment<3>(3 * static_cast<Eigen::Index>(i)) = field(nodes[i]);
+  return u;
+}
+
+TEST(Fem, BothOrdersIntegrateUniformStrainAndSecondMomentsExactly) {
+  const TetMesh mesh = tetsOrDie(core::makeUvEllipsoid(Vec3(1.0, 0.6, 0.3), 16, 8));
+  const QuadraticTetMesh quadratic = makeQuadratic(mesh);
+  ASSERT_EQ(quadratic.cornerCount, mesh.nodeCount());
+  for (std::size_t i = 0; i < mesh.nodeCount(); ++i)
+    ASSERT_EQ(quadratic.nodes[i], mesh.nodes[i]);
+  const core::MassProperties tets = core::computeTetMassProperties(mesh);
+  const core::Mat3 covariance = core::covarianceFromInertia(tets.inertia);
+  const FemMaterial material{.youngsModulus = 3.0, .poissonRatio = 0.25, .density = 2.0};
+  const double lambda = 3.0 * 0.25 / (1.25 * 0.5), mu = 3.0 / 2.5;
+  // u = E x with E symmetric: uniform strain E, energy density λ (tr E)² / 2 + μ E:E.
+  core::Mat3 strain;
+  strain << 0.3, 0.1, -0.2, 0.1, -0.5, 0.05, -0.2, 0.05, 0.7;
+  const double energy =
+      tets.volume * (0.5 * lambda * strain.trace() * strain.trace() + mu * strain.cwiseProduct(strain).sum());
+  const auto check = [&](const std::vector<Vec3>& nodes, const FemMatrices& fem, const char* order) {
+    const Eigen::VectorXd u = interpolate(nodes, [&](const Vec3& p) -> Vec3 { return strain * p; });
+    EXPECT_NEAR(0.5 * u.dot(fem.stiffness * u), energy, 1e-10 * energy) << order;
+    const Eigen::VectorXd rotation =
+        interpolate(nodes, [](const Vec3& p) { return Vec3(-p.y(), p.x(), 0.0); });
+    EXPECT_LT((fem.stiffness * rotation).norm(), 1e-10 * fem.stiffness.norm() * rotation.norm()) << order;
+    // uᵀMu for u = x e_x: ρ ∫ x² dV (x is in both spaces; so is x², which the mass integrates exactly).
+    const Eigen::VectorXd ux =
+        interpolate(nodes, [&](const Vec3& p) { return Vec3(p.x() - tets.centerOfMass.x(), 0.0, 0.0); });
+    EXPECT_NEAR(ux.dot(fem.mass * ux), 2.0 * covariance(0, 0), 1e-12 * covariance(0, 0)) << order;
+  };
+  check(mesh.nodes, assembleFem(mesh, material), "linear");
+  check(quadratic.nodes, assembleFem(quadratic, material), "quadratic");
+}
+
+TEST(Modal, QuadraticSparseAgreesWithDenseAndModesAreMOrthonormal) {
+  const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.3, 0.9, 0.6)), {.maxVolumeFraction = 1.0 / 12.0});
+  const QuadraticTetMesh quadratic = makeQuadratic(mesh);
+  ASSERT_LT(quadratic.nodeCount(), 400u);
+  const ModalOptions options{.modes = 10, .material = {}, .order = ElementOrder::kQuadratic};
+  Result<core::ModalData> full = computeModes(quadratic, options);
+  Result<core::ModalData> corners = computeModes(mesh, options);
+  Result<core::ModalData> dense = computeModesDense(mesh, options);
+  ASSERT_TRUE(full.ok()) << full.error().message;
+  ASSERT_TRUE(corners.ok()) << corners.error().message;
+  ASSERT_TRUE(dense.ok()) << dense.error().message;
+  ASSERT_EQ(full->shapes.rows(), 3 * static_cast<Eigen::Index>(quadratic.nodeCount()));
+  ASSERT_EQ(corners->shapes.rows(), 3 * static_cast<Eigen::Index>(mesh.nodeCount()));
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_NEAR(full->eigenvalues[i], dense->eigenvalues[i], 1e-8 * dense->eigenvalues[i]) << "mode " << i;
+    EXPECT_EQ(corners->eigenvalues[i], full->eigenvalues[i]);
+  }
+  EXPECT_EQ(corners->shapes, full->shapes.topRows(corners->shapes.rows()));
+  const FemMatrices fem = assembleFem(quadratic, options.material);
+  const Eigen::MatrixXd gram = full->shapes.transpose() * fem.mass * full->shapes;
+  EXPECT_LT((gram - Eigen::MatrixXd::Identity(10, 10)).cwiseAbs().maxCoeff(), 1e-9);
+  for (int i = 0; i < 10; ++i) {
+    const Eigen::VectorXd phi = full->shapes.col(i);
+    EXPECT_LT((fem.stiffness * phi - full->eigenvalues[i] * (fem.mass * phi)).norm(),
+              1e-7 * full->eigenvalues[i] * (fem.mass * phi).norm());
+  }
+}
+
+TEST(Modal, QuadraticTetsDoNotLockInBending) {
+  // A plate 5 : 4 : 1 of a few hundred tets, one or two through its thickness. Constant-strain tets
+  // cannot bend without shearing and come out far too stiff (+84 %); quadratic ones on the same mesh are
+  // within 2 % of quadratic ones on a mesh six times finer (+1.1 %).
+  const core::TriangleMesh plate = core::makeBox(Vec3(1.0, 0.8, 0.2));
+  const TetMesh coarse = tetsOrDie(plate, {.maxVolumeFraction = 1.0 / 150.0});
+  const TetMesh fine = tetsOrDie(plate, {.maxVolumeFraction = 1.0 / 1200.0});
+  const auto first = [](const TetMesh& mesh, ElementOrder order) {
+    Result<core::ModalData> m = computeModes(mesh, {.modes = 4, .material = {}, .order = order});
+    EXPECT_TRUE(m.ok()) << (m ? "" : m.error().message);
+    return m ? std::sqrt(m->eigenvalues[0]) : 0.0;
+  };
+  const double linear = first(coarse, ElementOrder::kLinear),
+               quadratic = first(coarse, ElementOrder::kQuadratic),
+               reference = first(fine, ElementOrder::kQuadratic);
+  std::printf("plate: %zu tets, ω1 linear %.4f, quadratic %.4f; %zu tets, quadratic %.4f\n",
+              coarse.tetCount(), linear, quadratic, fine.tetCount(), reference);
+  EXPECT_NEAR(quadratic, reference, 0.02 * reference);
+  EXPECT_GE(quadratic, reference * (1.0 - 1e-9));  // a coarser conforming mesh is stiffer, never softer
+  EXPECT_GT(linear, 1.2 * reference);
 }
 
 TEST(Modal, SparseLanczosAgreesWithDenseSolverAndModesAreMOrthonormal) {

@@ -54,15 +54,15 @@ class ShiftInvertLdlt {
 
 /// The six rigid motions (translations along and rotations about x, y, z through the centroid of the
 /// nodes), M-orthonormalized by Gram–Schmidt in the M inner product.
-Eigen::MatrixXd rigidMotions(const TetMesh& mesh, const SparseMatrix& mass) {
-  const auto n = static_cast<Eigen::Index>(mesh.nodeCount());
+Eigen::MatrixXd rigidMotions(const std::vector<core::Vec3>& nodes, const SparseMatrix& mass) {
+  const auto n = static_cast<Eigen::Index>(nodes.size());
   core::Vec3 center = core::Vec3::Zero();
-  for (const core::Vec3& p : mesh.nodes)
+  for (const core::Vec3& p : nodes)
     center += p;
   center /= static_cast<double>(n);
   Eigen::MatrixXd r = Eigen::MatrixXd::Zero(3 * n, 6);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const core::Vec3 p = mesh.nodes[static_cast<std::size_t>(i)] - center;
+    const core::Vec3 p = nodes[static_cast<std::size_t>(i)] - center;
     for (int k = 0; k < 3; ++k)
       r(3 * i + k, k) = 1.0;
     r.block<3, 1>(3 * i, 3) = core::Vec3(0.0, -p.z(), p.y());
@@ -79,7 +79,7 @@ Eigen::MatrixXd rigidMotions(const TetMesh& mesh, const SparseMatrix& mass) {
   return r;
 }
 
-Status checkOptions(const TetMesh& mesh, const ModalOptions& options) {
+Status checkOptions(std::size_t nodeCount, const ModalOptions& options) {
   const FemMaterial& m = options.material;
   if (options.modes < 1) return Error{ErrorCode::kInvalidArgument, "at least one mode must be asked for"};
   if (!(m.youngsModulus > 0.0 && m.density > 0.0 && std::isfinite(m.youngsModulus) &&
@@ -87,7 +87,7 @@ Status checkOptions(const TetMesh& mesh, const ModalOptions& options) {
     return Error{ErrorCode::kInvalidArgument, "Young's modulus and density must be finite and positive"};
   if (!(m.poissonRatio >= 0.0 && m.poissonRatio < 0.5))
     return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in [0, 0.5)"};
-  if (3 * mesh.nodeCount() < static_cast<std::size_t>(options.modes) + 6 + 2)
+  if (3 * nodeCount < static_cast<std::size_t>(options.modes) + 6 + 2)
     return Error{ErrorCode::kInvalidArgument,
                  "the tet mesh has too few nodes for " + std::to_string(options.modes) + " modes"};
   return Ok{};
@@ -144,64 +144,261 @@ Result<ModalData> makeModalData(const Eigen::VectorXd& eigenvalues, const Eigen:
 
 }  // namespace
 
-FemMatrices assembleFem(const TetMesh& mesh, const FemMaterial& material) {
+QuadraticTetMesh makeQuadratic(const TetMesh& mesh) {
+  constexpr std::array<std::array<int, 2>, 6> kEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+  const auto key = [](std::uint32_t a, std::uint32_t b) {
+    return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+  };
+  std::vector<std::uint64_t> edges;
+  edges.reserve(6 * mesh.tetCount());
+  for (const TetMesh::Tet& tet : mesh.tets)
+    for (const auto& [a, b] : kEdges)
+      edges.push_back(key(tet[static_cast<std::size_t>(a)], tet[static_cast<std::size_t>(b)]));
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+
+  QuadraticTetMesh out;
+  out.cornerCount = mesh.nodeCount();
+  out.nodes = mesh.nodes;
+  out.nodes.reserve(mesh.nodeCount() + edges.size());
+  for (std::uint64_t e : edges)
+    out.nodes.push_back(0.5 * (mesh.nodes[e >> 32] + mesh.nodes[e & 0xffffffffu]));
+  out.tets.reserve(mesh.tetCount());
+  for (const TetMesh::Tet& tet : mesh.tets) {
+    QuadraticTetMesh::Tet q{};
+    std::copy(tet.begin(), tet.end(), q.begin());
+    for (std::size_t e = 0; e < kEdges.size(); ++e) {
+      const std::uint64_t k =
+          key(tet[static_cast<std::size_t>(kEdges[e][0])], tet[static_cast<std::size_t>(kEdges[e][1])]);
+      const auto at = std::lower_bound(edges.begin(), edges.end(), k) - edges.begin();
+      q[4 + e] = static_cast<std::uint32_t>(mesh.nodeCount() + static_cast<std::size_t>(at));
+    }
+    out.tets.push_back(q);
+  }
+  return out;
+}
+
+Eigen::Matrix<double, 3, 10> quadraticGradients(const Eigen::Matrix<double, 3, 4>& barycentricGradients,
+                                                const Eigen::Vector4d& l) {
+  // Corners: N_a = L_a (2 L_a − 1); edges: N_ab = 4 L_a L_b.
+  constexpr std::array<std::array<int, 2>, 6> kEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+  const auto& g = barycentricGradients;
+  Eigen::Matrix<double, 3, 10> out;
+  for (int a = 0; a < 4; ++a)
+    out.col(a) = (4.0 * l[a] - 1.0) * g.col(a);
+  for (int e = 0; e < 6; ++e) {
+    const int a = kEdges[static_cast<std::size_t>(e)][0], b = kEdges[static_cast<std::size_t>(e)][1];
+    out.col(4 + e) = 4.0 * (l[a] * g.col(b) + l[b] * g.col(a));
+  }
+  return out;
+}
+
+const Eigen::Matrix<double, 10, 10>& quadraticReferenceMass() {
+  // Each shape function as a homogeneous quadratic form Lᵀ Q L in the barycentric coordinates (L_a =
+  // L_a Σ_b L_b), and ∫ L^α dV / V = 6 α! / (|α| + 3)! for the quartic monomials of their products.
+  static const Eigen::Matrix<double, 10, 10> mass = [] {
+    constexpr std::array<std::array<int, 2>, 6> kEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+    std::array<Eigen::Matrix4d, 10> q;
+    for (int a = 0; a < 4; ++a) {  // L_a² − Σ_{b≠a} L_a L_b
+      q[static_cast<std::size_t>(a)] = Eigen::Matrix4d::Zero();
+      q[static_cast<std::size_t>(a)].row(a).setConstant(-0.5);
+      q[static_cast<std::size_t>(a)].col(a).setConstant(-0.5);
+      q[static_cast<std::size_t>(a)](a, a) = 1.0;
+    }
+    for (std::size_t e = 0; e < 6; ++e) {  // 4 L_a L_b
+      q[4 + e] = Eigen::Matrix4d::Zero();
+      q[4 + e](kEdges[e][0], kEdges[e][1]) = q[4 + e](kEdges[e][1], kEdges[e][0]) = 2.0;
+    }
+    const auto monomial = [](int i, int j, int k, int l) {
+      std::array<int, 4> power{};
+      for (int v : {i, j, k, l})
+        ++power[static_cast<std::size_t>(v)];
+      double factorials = 1.0;
+      for (int p : power)
+        for (int f = 2; f <= p; ++f)
+          factorials *= f;
+      return 6.0 * factorials / 5040.0;  // 7!
+    };
+    Eigen::Matrix<double, 10, 10> m = Eigen::Matrix<double, 10, 10>::Zero();
+    for (std::size_t p = 0; p < 10; ++p)
+      for (std::size_t r = 0; r < 10; ++r)
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j)
+            for (int k = 0; k < 4; ++k)
+              for (int l = 0; l < 4; ++l)
+                m(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(r)) +=
+                    q[p](i, j) * q[r](k, l) * monomial(i, j, k, l);
+    return m;
+  }();
+  return mass;
+}
+
+const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints() {
+  static const std::array<Eigen::Vector4d, 4> points = [] {
+    const double a = 0.5854101966249685, b = 0.1381966011250105;  // (5 ± 3√5) / 20
+    return std::array<Eigen::Vector4d, 4>{Eigen::Vector4d(a, b, b, b), Eigen::Vector4d(b, a, b, b),
+                                          Eigen::Vector4d(b, b, a, b), Eigen::Vector4d(b, b, b, a)};
+  }();
+  return points;
+}
+
+namespace {
+
+/// Isotropic elasticity in Voigt order (xx, yy, zz, yz, xz, xy) with engineering shear strains.
+Eigen::Matrix<double, 6, 6> elasticity(const FemMaterial& material) {
   const double e = material.youngsModulus, nu = material.poissonRatio;
-  // Isotropic elasticity in Voigt order (xx, yy, zz, yz, xz, xy) with engineering shear strains.
   Eigen::Matrix<double, 6, 6> d = Eigen::Matrix<double, 6, 6>::Zero();
   const double lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = e / (2.0 * (1.0 + nu));
   d.topLeftCorner<3, 3>().setConstant(lambda);
   d.topLeftCorner<3, 3>().diagonal().array() += 2.0 * mu;
   d.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
-
-  std::vector<Eigen::Triplet<double>> kTriplets, mTriplets;
-  kTriplets.reserve(mesh.tetCount() * 144);
-  mTriplets.reserve(mesh.tetCount() * 48);
-  for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
-    const auto& tet = mesh.tets[t];
-    const auto [grad, volume] = core::tetGradients(mesh, t);
-    Eigen::Matrix<double, 6, 12> b = Eigen::Matrix<double, 6, 12>::Zero();
-    for (int a = 0; a < 4; ++a) {
-      const double gx = grad(0, a), gy = grad(1, a), gz = grad(2, a);
-      b(0, 3 * a) = gx;
-      b(1, 3 * a + 1) = gy;
-      b(2, 3 * a + 2) = gz;
-      b(3, 3 * a + 1) = gz;
-      b(3, 3 * a + 2) = gy;
-      b(4, 3 * a) = gz;
-      b(4, 3 * a + 2) = gx;
-      b(5, 3 * a) = gy;
-      b(5, 3 * a + 1) = gx;
-    }
-    const Eigen::Matrix<double, 12, 12> ke = volume * b.transpose() * d * b;
-    for (int i = 0; i < 12; ++i)
-      for (int j = 0; j < 12; ++j)
-        kTriplets.emplace_back(3 * static_cast<int>(tet[static_cast<std::size_t>(i / 3)]) + i % 3,
-                               3 * static_cast<int>(tet[static_cast<std::size_t>(j / 3)]) + j % 3, ke(i, j));
-    // Consistent mass of a linear tet: ρV/20 · (1 + δ_ab) per axis.
-    for (int a = 0; a < 4; ++a)
-      for (int bb = 0; bb < 4; ++bb)
-        for (int k = 0; k < 3; ++k)
-          mTriplets.emplace_back(3 * static_cast<int>(tet[static_cast<std::size_t>(a)]) + k,
-                                 3 * static_cast<int>(tet[static_cast<std::size_t>(bb)]) + k,
-                                 material.density * volume / 20.0 * (a == bb ? 2.0 : 1.0));
-  }
-  const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
-  FemMatrices matrices;
-  matrices.stiffness.resize(n, n);
-  matrices.mass.resize(n, n);
-  matrices.stiffness.setFromTriplets(kTriplets.begin(), kTriplets.end());
-  matrices.mass.setFromTriplets(mTriplets.begin(), mTriplets.end());
-  return matrices;
+  return d;
 }
 
-Result<ModalData> computeModes(const TetMesh& mesh, const ModalOptions& options) {
-  if (Status ok = checkOptions(mesh, options); !ok) return ok.error();
-  const FemMatrices fem = assembleFem(mesh, options.material);
-  const auto n = fem.stiffness.rows();
+/// The strain–displacement matrix of N nodes from their shape-function gradients (columns).
+template <int N>
+Eigen::Matrix<double, 6, 3 * N> strainDisplacement(const Eigen::Matrix<double, 3, N>& grad) {
+  Eigen::Matrix<double, 6, 3 * N> b = Eigen::Matrix<double, 6, 3 * N>::Zero();
+  for (int a = 0; a < N; ++a) {
+    const double gx = grad(0, a), gy = grad(1, a), gz = grad(2, a);
+    b(0, 3 * a) = gx;
+    b(1, 3 * a + 1) = gy;
+    b(2, 3 * a + 2) = gz;
+    b(3, 3 * a + 1) = gz;
+    b(3, 3 * a + 2) = gy;
+    b(4, 3 * a) = gz;
+    b(4, 3 * a + 2) = gx;
+    b(5, 3 * a) = gy;
+    b(5, 3 * a + 1) = gx;
+  }
+  return b;
+}
 
+/// Assembles element matrices straight into the compressed storage of K and M: the pattern first (3 × 3
+/// blocks per pair of nodes that share an element), then each element's values added where they belong.
+/// About ten times faster than Eigen's triplets for quadratic tets, which bring 900 + 300 of them each.
+template <std::size_t N>
+class Assembler {
+ public:
+  using Element = std::array<std::uint32_t, N>;
+
+  Assembler(std::size_t nodeCount, const std::vector<Element>& elements) {
+    // Node adjacency (each node with itself too), CSR with sorted neighbours.
+    std::vector<std::uint64_t> pairs;
+    pairs.reserve(elements.size() * N * N);
+    for (const Element& e : elements)
+      for (std::uint32_t a : e)
+        for (std::uint32_t b : e)
+          pairs.push_back((static_cast<std::uint64_t>(b) << 32) | a);
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    mStart.assign(nodeCount + 1, 0);
+    mNeighbours.resize(pairs.size());
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      ++mStart[(pairs[i] >> 32) + 1];
+      mNeighbours[i] = static_cast<std::uint32_t>(pairs[i] & 0xffffffffu);
+    }
+    for (std::size_t i = 0; i < nodeCount; ++i)
+      mStart[i + 1] += mStart[i];
+    // Column 3b + c of the 3n × 3n matrix: rows 3a, 3a + 1, 3a + 2 for every neighbour a of b.
+    const auto n = static_cast<Eigen::Index>(3 * nodeCount);
+    for (Eigen::SparseMatrix<double>* m : {&mMatrices.stiffness, &mMatrices.mass}) {
+      m->resize(n, n);
+      m->resizeNonZeros(static_cast<Eigen::Index>(9 * pairs.size()));
+      int* outer = m->outerIndexPtr();
+      int* inner = m->innerIndexPtr();
+      for (std::size_t b = 0; b < nodeCount; ++b) {
+        const std::size_t degree = mStart[b + 1] - mStart[b];
+        for (std::size_t c = 0; c < 3; ++c) {
+          const std::size_t column = 3 * b + c, first = 9 * mStart[b] + 3 * degree * c;
+          outer[column] = static_cast<int>(first);
+          for (std::size_t k = 0; k < degree; ++k)
+            for (std::size_t r = 0; r < 3; ++r)
+              inner[first + 3 * k + r] = static_cast<int>(3 * mNeighbours[mStart[b] + k] + r);
+        }
+      }
+      outer[n] = static_cast<int>(9 * pairs.size());
+      std::fill_n(m->valuePtr(), 9 * pairs.size(), 0.0);
+    }
+  }
+
+  /// Adds an element's stiffness (3N × 3N) and its scalar mass (N × N, on each axis).
+  void add(const Element& e, const Eigen::Matrix<double, 3 * N, 3 * N>& ke,
+           const Eigen::Matrix<double, static_cast<int>(N), static_cast<int>(N)>& scalarMass) {
+    double* k = mMatrices.stiffness.valuePtr();
+    double* m = mMatrices.mass.valuePtr();
+    for (std::size_t j = 0; j < N; ++j) {
+      const std::uint32_t b = e[j];
+      const auto begin = mNeighbours.begin() + static_cast<std::ptrdiff_t>(mStart[b]);
+      const auto end = mNeighbours.begin() + static_cast<std::ptrdiff_t>(mStart[b + 1]);
+      const std::size_t degree = mStart[b + 1] - mStart[b];
+      for (std::size_t i = 0; i < N; ++i) {
+        const auto slot = static_cast<std::size_t>(std::lower_bound(begin, end, e[i]) - begin);
+        for (std::size_t c = 0; c < 3; ++c) {
+          const std::size_t at = 9 * mStart[b] + 3 * degree * c + 3 * slot;
+          for (std::size_t r = 0; r < 3; ++r)
+            k[at + r] += ke(static_cast<Eigen::Index>(3 * i + r), static_cast<Eigen::Index>(3 * j + c));
+          m[at + c] += scalarMass(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+        }
+      }
+    }
+  }
+
+  /// K and M; M without the zeros of the pattern (the 3 × 3 blocks of the mass are diagonal).
+  FemMatrices finish() && {
+    mMatrices.mass.prune(0.0);
+    return std::move(mMatrices);
+  }
+
+ private:
+  std::vector<std::size_t> mStart;
+  std::vector<std::uint32_t> mNeighbours;
+  FemMatrices mMatrices;
+};
+
+}  // namespace
+
+FemMatrices assembleFem(const TetMesh& mesh, const FemMaterial& material) {
+  const Eigen::Matrix<double, 6, 6> d = elasticity(material);
+  // Consistent mass of a linear tet: ρV/20 · (1 + δ_ab) per axis.
+  const Eigen::Matrix4d referenceMass = (Eigen::Matrix4d::Ones() + Eigen::Matrix4d::Identity()) / 20.0;
+  Assembler<4> assembler(mesh.nodeCount(), mesh.tets);
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
+    const auto [grad, volume] = core::tetGradients(mesh, t);
+    const Eigen::Matrix<double, 6, 12> b = strainDisplacement<4>(grad);
+    const Eigen::Matrix<double, 12, 12> ke = volume * b.transpose() * d * b;
+    const Eigen::Matrix4d me = material.density * volume * referenceMass;
+    assembler.add(mesh.tets[t], ke, me);
+  }
+  return std::move(assembler).finish();
+}
+
+FemMatrices assembleFem(const QuadraticTetMesh& mesh, const FemMaterial& material) {
+  const Eigen::Matrix<double, 6, 6> d = elasticity(material);
+  Assembler<10> assembler(mesh.nodeCount(), mesh.tets);
+  for (const QuadraticTetMesh::Tet& tet : mesh.tets) {
+    const auto [grad, volume] =
+        core::tetGradients({mesh.nodes[tet[0]], mesh.nodes[tet[1]], mesh.nodes[tet[2]], mesh.nodes[tet[3]]});
+    Eigen::Matrix<double, 30, 30> ke = Eigen::Matrix<double, 30, 30>::Zero();
+    for (const Eigen::Vector4d& l : quadraticQuadraturePoints()) {
+      const Eigen::Matrix<double, 6, 30> b = strainDisplacement<10>(quadraticGradients(grad, l));
+      ke.noalias() += (volume / 4.0) * b.transpose() * d * b;
+    }
+    const Eigen::Matrix<double, 10, 10> me = material.density * volume * quadraticReferenceMass();
+    assembler.add(tet, ke, me);
+  }
+  return std::move(assembler).finish();
+}
+
+namespace {
+
+/// Shift-invert Lanczos on assembled matrices (computeModes of either order).
+Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMatrices& fem,
+                              const ModalOptions& options) {
+  const auto n = fem.stiffness.rows();
   // The rigid modes are known in closed form: detect them (K r ≈ 0, Rayleigh quotients near zero) and
   // deflate them, so that Lanczos looks for the elastic modes only.
-  const Eigen::MatrixXd rigid = rigidMotions(mesh, fem.mass);
+  const Eigen::MatrixXd rigid = rigidMotions(nodes, fem.mass);
   std::array<double, 6> rigidEigenvalues{};
   for (int j = 0; j < 6; ++j)
     rigidEigenvalues[static_cast<std::size_t>(j)] = rigid.col(j).dot(fem.stiffness * rigid.col(j));
@@ -227,19 +424,50 @@ Result<ModalData> computeModes(const TetMesh& mesh, const ModalOptions& options)
   return makeModalData(eigs.eigenvalues(), eigs.eigenvectors(), rigidEigenvalues, fem, options);
 }
 
-Result<ModalData> computeModesDense(const TetMesh& mesh, const ModalOptions& options) {
-  if (Status ok = checkOptions(mesh, options); !ok) return ok.error();
-  const FemMatrices fem = assembleFem(mesh, options.material);
+/// All 3n eigenpairs by the dense solver: the six smallest must be the rigid ones.
+Result<ModalData> solveDense(const FemMatrices& fem, const ModalOptions& options) {
   const Eigen::MatrixXd k(fem.stiffness), m(fem.mass);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(k, m);
   if (solver.info() != Eigen::Success) return Error{ErrorCode::kParse, "dense eigensolver failed"};
-  // All 3n eigenvalues: the six smallest must be the rigid ones.
   const Eigen::VectorXd& all = solver.eigenvalues();
   std::array<double, 6> rigid{};
   for (std::size_t i = 0; i < 6; ++i)
     rigid[i] = all[static_cast<Eigen::Index>(i)];
   return makeModalData(all.segment(6, all.size() - 6), solver.eigenvectors().rightCols(all.size() - 6), rigid,
                        fem, options);
+}
+
+/// The quadratic modes at the corners only.
+Result<ModalData> cornersOnly(Result<ModalData> modes, std::size_t cornerCount) {
+  if (!modes) return modes;
+  ModalData corners = std::move(modes).value();
+  corners.shapes.conservativeResize(3 * static_cast<Eigen::Index>(cornerCount), Eigen::NoChange);
+  return corners;
+}
+
+}  // namespace
+
+Result<ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOptions& options) {
+  if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
+  return solveSparse(mesh.nodes, assembleFem(mesh, options.material), options);
+}
+
+Result<ModalData> computeModes(const TetMesh& mesh, const ModalOptions& options) {
+  if (options.order == ElementOrder::kQuadratic) {
+    if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
+    return cornersOnly(computeModes(makeQuadratic(mesh), options), mesh.nodeCount());
+  }
+  if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
+  return solveSparse(mesh.nodes, assembleFem(mesh, options.material), options);
+}
+
+Result<ModalData> computeModesDense(const TetMesh& mesh, const ModalOptions& options) {
+  if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
+  if (options.order == ElementOrder::kQuadratic) {
+    const QuadraticTetMesh quadratic = makeQuadratic(mesh);
+    return cornersOnly(solveDense(assembleFem(quadratic, options.material), options), mesh.nodeCount());
+  }
+  return solveDense(assembleFem(mesh, options.material), options);
 }
 
 }  // namespace shapedb::volume

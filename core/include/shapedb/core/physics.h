@@ -37,6 +37,8 @@ struct TetGradients {
   double volume = 0.0;
 };
 TetGradients tetGradients(const TetMesh& mesh, std::size_t t);
+/// The same for a tet given by its four corners.
+TetGradients tetGradients(const std::array<Vec3, 4>& corners);
 
 /// Checks indices, finiteness and that every tet has positive volume (relative to the mesh's scale).
 /// Errors: kEmptyMesh, kIndexOutOfRange, kNonFinite, kDegenerateFace (a flat or inverted tet).

@@ -1,5 +1,9 @@
 #pragma once
 
+#include <array>
+#include <cstdint>
+#include <vector>
+
 #include <Eigen/SparseCore>
 
 #include <shapedb/core/physics.h>
@@ -26,21 +30,63 @@ struct FemMaterial {
 /// Assembles K and M. Preconditions: core::validateTetMesh(mesh) passed; 0 ≤ ν < 0.5.
 FemMatrices assembleFem(const core::TetMesh& mesh, const FemMaterial& material = {});
 
-/// How many modes, for which material.
+/// Quadratic (10-node) tets on a linear tet mesh, for bending: constant-strain tets lock, a plate two or
+/// three tets thick comes out tens of per cent too stiff, while quadratic ones on the same mesh are within
+/// a few per cent. The linear mesh's nodes come first with their own indices, then one node at the
+/// midpoint of each edge; the edges are numbered in the order of their (smaller, larger) node pair.
+struct QuadraticTetMesh {
+  /// Corners 0–3 as in the linear tet, then the edges 01, 02, 03, 12, 13, 23.
+  using Tet = std::array<std::uint32_t, 10>;
+  std::vector<core::Vec3> nodes;
+  std::vector<Tet> tets;
+  std::size_t cornerCount = 0;  ///< the linear mesh's nodes: nodes[0, cornerCount)
+  std::size_t nodeCount() const { return nodes.size(); }
+};
+QuadraticTetMesh makeQuadratic(const core::TetMesh& mesh);
+
+/// Shape functions of the 10-node tet at barycentric coordinates `l`: gradients (columns, node order of
+/// QuadraticTetMesh::Tet) from the gradients of the barycentric coordinates (core::tetGradients).
+Eigen::Matrix<double, 3, 10> quadraticGradients(const Eigen::Matrix<double, 3, 4>& barycentricGradients,
+                                                const Eigen::Vector4d& l);
+
+/// The reference scalar mass matrix of the 10-node tet: ∫ N_a N_b dV / V, exact.
+const Eigen::Matrix<double, 10, 10>& quadraticReferenceMass();
+
+/// The quadrature of degree 2 the quadratic stiffness needs (exact for it): four points, weight V/4
+/// each, at these barycentric coordinates.
+const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints();
+
+/// K and M of the quadratic tets (stiffness by the exact four-point rule, consistent mass exact).
+FemMatrices assembleFem(const QuadraticTetMesh& mesh, const FemMaterial& material = {});
+
+/// Which elements the modal analysis uses.
+enum class ElementOrder : std::uint8_t { kLinear = 1, kQuadratic = 2 };
+
+/// How many modes, for which material, on which elements.
 struct ModalOptions {
   int modes = 20;  ///< non-rigid modes wanted, ≥ 1
   FemMaterial material;
+  /// Quadratic: the modes of the 10-node tets on the same mesh, their shapes reported at the linear
+  /// mesh's nodes (the corners; the mid-edge values are dropped). Linear by default, for now: the database
+  /// stores linear modes, and its tet meshes are too fine for quadratic ones within the build's budget.
+  ElementOrder order = ElementOrder::kLinear;
 };
 
 /// The first `modes` non-rigid modes of the free body, K φ = λ M φ, by shift-invert Lanczos (Spectra)
 /// around a small negative shift, K − σM factorized once by sparse Cholesky (LDLᵀ). The six smallest
 /// eigenvalues must be the rigid modes (≈ 0 against the first elastic one); they are checked and
-/// dropped. Mode shapes are M-orthonormal. Errors: kInvalidArgument (options, too few nodes), kParse when
+/// dropped. Mode shapes are M-orthonormal (quadratic order: over all ten nodes of each tet, before the
+/// mid-edge values are dropped). Errors: kInvalidArgument (options, too few nodes), kParse when
 /// the mesh is not one connected solid (more or fewer than six rigid modes) or Lanczos does not converge.
 Result<core::ModalData> computeModes(const core::TetMesh& mesh, const ModalOptions& options = {});
 
+/// The modes on every node of the quadratic mesh (shapes 3·quadratic.nodeCount() × m), M-orthonormal for
+/// its mass matrix; computeModes of the quadratic order keeps their first 3·cornerCount rows.
+Result<core::ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOptions& options = {});
+
 /// The oracle: the same modes from a dense generalized eigensolver over all 3n degrees of freedom
-/// (Eigen's GeneralizedSelfAdjointEigenSolver, O(n³)). For meshes of a few hundred nodes: tests only.
+/// (Eigen's GeneralizedSelfAdjointEigenSolver, O(n³)), of options.order. For meshes of a few hundred nodes
+/// (quadratic: nodes and edges): tests only.
 Result<core::ModalData> computeModesDense(const core::TetMesh& mesh, const ModalOptions& options = {});
 
 }  // namespace shapedb::volume
