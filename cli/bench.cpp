@@ -12,6 +12,8 @@
 #include <shapedb/io/database.h>
 #include <shapedb/io/evaluation.h>
 #include <shapedb/io/mesh_io.h>
+#include <shapedb/volume/entry.h>
+#include <shapedb/volume/modal.h>
 
 #include "commands.h"
 #include "material_flags.h"
@@ -26,6 +28,7 @@ struct BenchCommandOptions {
   volume::FractureOptions fracture;
   std::string out;
   MaterialFlags material;
+  std::string directElements;
   io::EvaluationOptions evaluation;
 };
 
@@ -59,11 +62,20 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
     printError("give --queries DIR or --fracture MESH --pieces N, not both");
     return kExitUsage;
   }
+  if (!o.directElements.empty()) {
+    o.evaluation.directElements = volume::parseElementOrder(o.directElements);
+    if (!o.evaluation.directElements) {
+      printError("--direct-elements must be linear or quadratic, not '" + o.directElements + "'");
+      return kExitUsage;
+    }
+  }
   auto db = io::Database::open(o.database);
   if (!db) {
     printError(db.error().message);
     return kExitInputError;
   }
+  const volume::ElementOrder directOrder =
+      o.evaluation.directElements.value_or(db->parameters().entry.modal.order);
   Result<std::vector<io::NamedMesh>> shapes = loadShapes(o);
   if (!shapes) {
     printError(shapes.error().message);
@@ -95,8 +107,10 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
                                  ? o.fractureMesh + " broken into " + std::to_string(shapes->size()) +
                                        " fragments (seed " + std::to_string(o.fracture.seed) + ")"
                                  : o.queries;
-  const std::string title = "shapedb bench: " + source + ", against " + o.database + " (" +
-                            std::to_string(db->entries().size()) + " entries), " + material->name;
+  const std::string title =
+      "shapedb bench: " + source + ", against " + o.database + " (" + std::to_string(db->entries().size()) +
+      " entries, " + volume::toString(db->parameters().entry.modal.order) + " tets), " + material->name +
+      "; truth and baselines on " + volume::toString(directOrder) + " tets";
   for (Status st : {io::writeEvaluationCsv(*evaluations, out / "evaluation.csv"),
                     io::writeEvaluationSummary(*evaluations, title, out / "summary.md"),
                     io::writeEvaluationPlots(*evaluations, out)})
@@ -148,6 +162,10 @@ Command addBenchCommand(CLI::App& parent) {
                   "Sampling grid of the collision-proxy IoU, cells along the longest side")
       ->capture_default_str()
       ->check(CLI::Range(8, 512));
+  app->add_option("--direct-elements", o->directElements,
+                  "Tets of the direct computations (truth and baselines): linear or quadratic, with their\n"
+                  "TetGen bounds (default: the database's; quadratic ones are the better truth: linear ones\n"
+                  "lock in bending)");
   app->add_option("--threads", o->evaluation.threads, "Threads for the direct computations (0: all cores)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

@@ -332,7 +332,8 @@ Command addQueryCommand(CLI::App& parent) {
   app->add_flag("--stretch", o->stretch,
                 "Take the frequencies and modes from the entry stretched along its axes to the mesh's\n"
                 "proportions (second moments), by Rayleigh-Ritz on its modes, instead of scaling it\n"
-                "uniformly as the paper does (~1 ms more per query; docs/architecture.md)");
+                "uniformly as the paper does (~1 ms more per query; databases of linear tets only;\n"
+                "docs/architecture.md)");
   return {app, [o, app] { return runQuery(*o, *app); }};
 }
 

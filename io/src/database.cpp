@@ -317,6 +317,9 @@ Result<Database> Database::open(const std::filesystem::path& path, const OpenOpt
 const BuildParameters& Database::parameters() const {
   return mImpl->store.parameters();
 }
+bool Database::supportsStretchCorrection() const {
+  return parameters().entry.modal.order == volume::ElementOrder::kLinear;
+}
 const std::vector<EntryRecord>& Database::entries() const {
   return mImpl->entries;
 }
@@ -389,6 +392,10 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   QueryResult out;
   if (options.adapt)
     if (Status valid = core::validateMaterial(options.material); !valid) return valid.error();
+  if (options.adapt && options.stretchCorrection && !supportsStretchCorrection())
+    return Error{ErrorCode::kInvalidArgument,
+                 "the stretch correction needs a database of linear tets; " + mImpl->store.path().string() +
+                     " has quadratic ones (its stretch basis would need their mid-edge values)"};
 
   Clock::time_point t = Clock::now();
   if (Status valid = core::validateMesh(mesh); !valid) return valid.error();

@@ -139,6 +139,8 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
                                                        std::span<const NamedMesh> shapes,
                                                        const EvaluationOptions& options) {
   const volume::EntryOptions& entry = database.parameters().entry;
+  const volume::EntryOptions direct =
+      options.directElements ? volume::withElements(entry, *options.directElements) : entry;
   if (options.frequencies < 1 || options.frequencies > entry.modal.modes)
     return Error{ErrorCode::kInvalidArgument, "frequencies to compare must be 1 to the database's " +
                                                   std::to_string(entry.modal.modes) + " modes, not " +
@@ -174,8 +176,9 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
     }
     if (e.ok()) e.volume = queries[i][0]->massProperties.volume;
     // The centroid-voxel match adapted again with the stretch correction, timed as a cold query would
-    // pay it: the entry's stretch basis, then the adaptation.
-    if (e.ok()) {
+    // pay it: the entry's stretch basis, then the adaptation. Linear-tet databases only: for the others
+    // the column stays empty (no frequencies, errors NaN, left out of the medians).
+    if (e.ok() && database.supportsStretchCorrection()) {
       const QueryResult& q = *queries[i][kCentroidVoxelIndex];
       const Clock::time_point start = Clock::now();
       const core::StretchBasis basis =
@@ -198,7 +201,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
     FragmentEvaluation& e = out[i];
     const core::TriangleMesh& mesh = shapes[i].mesh;
     if (e.ok()) {
-      Result<volume::EntryData> truth = volume::computeEntry(mesh, entry);
+      Result<volume::EntryData> truth = volume::computeEntry(mesh, direct);
       if (!truth) {
         e.error = "direct computation: " + truth.error().message;
       } else {
@@ -257,7 +260,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
           const volume::ShapeResolution& res = database.parameters().resolution;
           evaluateBaseline(ellipsoid,
                            core::makeUvEllipsoid(radii, std::max(res.segments, 24), std::max(res.stacks, 12)),
-                           placedEllipsoid, shape, entry, options, e.truthFrequenciesHz, e.error);
+                           placedEllipsoid, shape, direct, options, e.truthFrequenciesHz, e.error);
           e.methods.push_back(std::move(ellipsoid));
 
           MethodEvaluation box;
@@ -271,7 +274,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
           boxSolid.shapes.push_back(boxShape);
           if (e.ok())
             evaluateBaseline(box, core::makeBox(2.0 * boxShape.halfExtents), core::sampledSolid(boxSolid),
-                             shape, entry, options, e.truthFrequenciesHz, e.error);
+                             shape, direct, options, e.truthFrequenciesHz, e.error);
           e.methods.push_back(std::move(box));
 
           // The centroid-voxel match, stretched to the shape's proportions before it is adapted.

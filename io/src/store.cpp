@@ -109,7 +109,10 @@ std::string toJson(const BuildParameters& p) {
       {"tetgen",
        {{"max_radius_edge_ratio", e.tetgen.maxRadiusEdgeRatio},
         {"max_volume_fraction", e.tetgen.maxVolumeFraction}}},
-      {"modes", {{"count", e.modal.modes}, {"poisson_ratio", e.modal.material.poissonRatio}}},
+      {"modes",
+       {{"count", e.modal.modes},
+        {"poisson_ratio", e.modal.material.poissonRatio},
+        {"elements", volume::toString(e.modal.order)}}},
       {"collision",
        {{"max_shapes", e.collision.maxShapes},
         {"target_coverage", e.collision.targetCoverage},
@@ -144,6 +147,10 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
     e.tetgen.maxVolumeFraction = j.at("tetgen").at("max_volume_fraction").get<double>();
     e.modal.modes = j.at("modes").at("count").get<int>();
     e.modal.material.poissonRatio = j.at("modes").at("poisson_ratio").get<double>();
+    // Files from before quadratic tets have no "elements": theirs are linear.
+    const auto order = volume::parseElementOrder(j.at("modes").value("elements", std::string("linear")));
+    if (!order) return Error{ErrorCode::kParse, "unknown element order in the build parameters"};
+    e.modal.order = *order;
     e.collision.maxShapes = j.at("collision").at("max_shapes").get<int>();
     e.collision.targetCoverage = j.at("collision").at("target_coverage").get<double>();
     e.collision.resolution = j.at("collision").at("resolution").get<int>();

@@ -13,6 +13,10 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 #include <shapedb/io/store.h>
+#include <shapedb/volume/entry.h>
+#include <shapedb/volume/families.h>
+#include <shapedb/volume/modal.h>
+#include <shapedb/volume/tetrahedralize.h>
 
 #include "support/subprocess.h"
 #include "support/test_support.h"
@@ -240,6 +244,58 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   EXPECT_EQ(family.exitCode, 2);
   EXPECT_NE(family.err.find("unknown family 'torus'"), std::string::npos) << family.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.db"));
+}
+
+TEST(BuildCli, QuadraticTetsEndToEnd) {
+  test::ScratchDir dir("build-quadratic");
+  const auto db = dir / "quadratic.db";
+  test::ProcessResult built =
+      test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box", "--modes",
+                                     "4", "--elements", "quadratic", "--quiet"});
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  test::ProcessResult info = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
+  ASSERT_EQ(info.exitCode, 0) << info.err;
+  const nlohmann::json parameters = nlohmann::json::parse(info.out)["parameters"];
+  EXPECT_EQ(parameters["modes"]["elements"], "quadratic");
+  EXPECT_EQ(parameters["tetgen"]["max_radius_edge_ratio"], 3.0);
+  test::ProcessResult text = test::runProcess(SHAPEDB_CLI, {"info", db.string()});
+  EXPECT_NE(text.out.find("on quadratic tets"), std::string::npos) << text.out;
+
+  // The first box entry's own surface, queried in unit material: its frequencies are those of quadratic
+  // tets computed directly on the same surface (same TetGen options, so the same mesh).
+  const core::TriangleMesh surface = *volume::makeFamilyShape(volume::familySpec(volume::Family::kBox, 0));
+  const auto mesh = dir / "box.ply";
+  ASSERT_TRUE(io::saveMesh(surface, mesh).ok());
+  test::ProcessResult q = test::runProcess(SHAPEDB_CLI, {"query", db.string(), mesh.string(), "--density",
+                                                         "1", "--youngs", "1", "--poisson", "0.3", "--json"});
+  ASSERT_EQ(q.exitCode, 0) << q.err;
+  const nlohmann::json physics = nlohmann::json::parse(q.out)["queries"][0]["physics"];
+  const volume::EntryOptions options = volume::withElements({}, volume::ElementOrder::kQuadratic);
+  auto tets = volume::tetrahedralize(surface, options.tetgen);
+  ASSERT_TRUE(tets.ok()) << tets.error().message;
+  auto direct =
+      volume::computeModes(*tets, {.modes = 4, .material = {}, .order = volume::ElementOrder::kQuadratic});
+  ASSERT_TRUE(direct.ok()) << direct.error().message;
+  ASSERT_EQ(physics["frequencies_hz"].size(), 4u);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_NEAR(physics["frequencies_hz"][static_cast<std::size_t>(i)].get<double>(),
+                direct->frequenciesHz()[i], 1e-6 * direct->frequenciesHz()[i])
+        << "mode " << i;
+
+  // The stretch correction is for linear tets: a clear refusal, not a wrong answer.
+  test::ProcessResult stretched =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), mesh.string(), "--stretch"});
+  EXPECT_NE(stretched.exitCode, 0);
+  EXPECT_NE(stretched.err.find("needs a database of linear tets"), std::string::npos) << stretched.err;
+  // An unknown order, and a resume that would change it.
+  test::ProcessResult cubic =
+      test::runProcess(SHAPEDB_CLI, {"build", (dir / "x.db").string(), "--elements", "cubic"});
+  EXPECT_EQ(cubic.exitCode, 2);
+  EXPECT_NE(cubic.err.find("linear or quadratic, not 'cubic'"), std::string::npos) << cubic.err;
+  test::ProcessResult resumed =
+      test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--resume", "--elements", "linear", "--quiet"});
+  EXPECT_EQ(resumed.exitCode, 2);
+  EXPECT_NE(resumed.err.find("another elements"), std::string::npos) << resumed.err;
 }
 
 }  // namespace

@@ -12,10 +12,12 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/database.h>
 #include <shapedb/io/store.h>
+#include <shapedb/volume/entry.h>
 #include <shapedb/volume/families.h>
 #include <shapedb/volume/modal.h>
 
@@ -283,6 +285,28 @@ TEST_F(SmallDatabase, ConcurrentQueriesAgreeWithSerialOnes) {
   for (auto& t : threads)
     t.join();
   EXPECT_EQ(mismatches.load(), 0);
+}
+
+TEST(BuildParametersJson, ElementOrderRoundTripsAndOlderFilesAreLinear) {
+  BuildParameters quadratic;
+  quadratic.families = {volume::Family::kBox};
+  quadratic.entry = volume::withElements(quadratic.entry, volume::ElementOrder::kQuadratic);
+  Result<BuildParameters> back = parseBuildParameters(toJson(quadratic));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->entry.modal.order, volume::ElementOrder::kQuadratic);
+  EXPECT_EQ(back->entry.tetgen.maxRadiusEdgeRatio, 3.0);
+  EXPECT_EQ(back->entry.tetgen.maxVolumeFraction, 1.0 / 100.0);
+
+  // A file written before the element order was stored: linear, as everything then was.
+  nlohmann::json older = nlohmann::json::parse(toJson(quadratic));
+  older["modes"].erase("elements");
+  back = parseBuildParameters(older.dump());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->entry.modal.order, volume::ElementOrder::kLinear);
+  older["modes"]["elements"] = "cubic";
+  back = parseBuildParameters(older.dump());
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().message.find("element order"), std::string::npos) << back.error().message;
 }
 
 TEST_F(SmallDatabase, OtherDescriptorParametersAreAClearError) {

@@ -107,6 +107,22 @@ TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
   for (const char* png : {"time.png", "error.png"})
     EXPECT_GT(std::filesystem::file_size(dir / png), 1000u) << png;
 
+  // The direct computations on quadratic tets: a thin plate's truth drops (linear tets lock in bending),
+  // and the plate is still its own box baseline.
+  const std::vector<NamedMesh> plate{{"plate", "", core::makeBox({0.3, 0.2, 0.03})}};
+  options.progress = nullptr;
+  auto linear = evaluateShapes(*db, plate, options);
+  options.directElements = volume::ElementOrder::kQuadratic;
+  auto quadratic = evaluateShapes(*db, plate, options);
+  ASSERT_TRUE(linear.ok() && quadratic.ok());
+  ASSERT_TRUE(linear->front().ok() && quadratic->front().ok())
+      << linear->front().error << quadratic->front().error;
+  std::printf("plate truth f1: linear %.1f Hz, quadratic %.1f Hz\n", linear->front().truthFrequenciesHz[0],
+              quadratic->front().truthFrequenciesHz[0]);
+  EXPECT_LT(quadratic->front().truthFrequenciesHz[0], 0.9 * linear->front().truthFrequenciesHz[0]);
+  EXPECT_LT(quadratic->front().methods[4].maxFrequencyError, 0.03);
+  options.directElements.reset();
+
   // Bad options are errors before any work.
   options.frequencies = 7;  // the database has 6 modes
   EXPECT_EQ(evaluateShapes(*db, shapes, options).error().code, ErrorCode::kInvalidArgument);

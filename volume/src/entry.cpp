@@ -23,6 +23,19 @@ class Stopwatch {
 
 }  // namespace
 
+EntryOptions withElements(EntryOptions options, ElementOrder order) {
+  options.modal.order = order;
+  const TetrahedralizeOptions defaults;
+  if (order == ElementOrder::kQuadratic) {
+    options.tetgen.maxRadiusEdgeRatio = 3.0;
+    options.tetgen.maxVolumeFraction = 1.0 / 100.0;
+  } else {
+    options.tetgen.maxRadiusEdgeRatio = defaults.maxRadiusEdgeRatio;
+    options.tetgen.maxVolumeFraction = defaults.maxVolumeFraction;
+  }
+  return options;
+}
+
 Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOptions& options) {
   EntryData entry;
   Stopwatch clock;

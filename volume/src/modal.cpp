@@ -144,6 +144,16 @@ Result<ModalData> makeModalData(const Eigen::VectorXd& eigenvalues, const Eigen:
 
 }  // namespace
 
+const char* toString(ElementOrder order) {
+  return order == ElementOrder::kQuadratic ? "quadratic" : "linear";
+}
+
+std::optional<ElementOrder> parseElementOrder(std::string_view name) {
+  if (name == "linear") return ElementOrder::kLinear;
+  if (name == "quadratic") return ElementOrder::kQuadratic;
+  return std::nullopt;
+}
+
 QuadraticTetMesh makeQuadratic(const TetMesh& mesh) {
   constexpr std::array<std::array<int, 2>, 6> kEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
   const auto key = [](std::uint32_t a, std::uint32_t b) {

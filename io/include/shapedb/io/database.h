@@ -81,6 +81,7 @@ struct QueryOptions {
   /// (core/stretch.h). Off by default: it costs ~1 ms a query (a 3m × 3m eigenproblem) and, the first
   /// time an entry is adapted, its stretch basis (~25 ms; cached with its data), and on the benchmark
   /// it narrows the worst errors more than the median (docs/architecture.md).
+  /// Linear-tet databases only (supportsStretchCorrection): an error otherwise.
   bool stretchCorrection = false;
   bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
   core::FidelityOptions fidelityOptions;
@@ -137,6 +138,9 @@ class Database {
   ~Database();
 
   const BuildParameters& parameters() const;
+  /// Whether QueryOptions::stretchCorrection can be used: its basis (core/stretch.h) is that of linear
+  /// tets, and a database of quadratic ones stores their modes at the corners only.
+  bool supportsStretchCorrection() const;
   const std::vector<EntryRecord>& entries() const;
   const EntryRecord* entry(core::EntryId id) const;
   const core::Index& index(core::DescriptorKind kind) const;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -72,6 +73,10 @@ struct EvaluationOptions {
   int frequencies = 5;         ///< non-rigid frequencies compared (at most the database's modes)
   int overlapResolution = 48;  ///< sampling grid of the volume overlap, cells along the longest side
   int threads = 0;             ///< for the direct computations; 0: all cores
+  /// Elements of the direct computations (the truth and both baselines), with their TetGen bounds
+  /// (volume::withElements); unset: the database's own. Quadratic ones do not lock in bending, so they
+  /// are the better truth for a database of either kind.
+  std::optional<volume::ElementOrder> directElements;
   /// Called after each shape's direct computation, from one thread at a time: done, total, its name.
   std::function<void(std::size_t, std::size_t, const std::string&)> progress;
 };

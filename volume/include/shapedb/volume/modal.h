@@ -2,6 +2,8 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/SparseCore>
@@ -61,6 +63,9 @@ FemMatrices assembleFem(const QuadraticTetMesh& mesh, const FemMaterial& materia
 
 /// Which elements the modal analysis uses.
 enum class ElementOrder : std::uint8_t { kLinear = 1, kQuadratic = 2 };
+/// "linear", "quadratic", and back (nullopt for anything else).
+const char* toString(ElementOrder order);
+std::optional<ElementOrder> parseElementOrder(std::string_view name);
 
 /// How many modes, for which material, on which elements.
 struct ModalOptions {
