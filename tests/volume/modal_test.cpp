@@ -48,7 +48,7 @@ TEST(Fem, QuadraticReferenceMassIsTheClosedForm) {
   // ∫ N_a N_b dV / V of the 10-node tet, times 420: corners 6 (same) and 1 (two corners), corner and
   // edge −4 (the edge ends at the corner) or −6, edges 32 (same), 16 (sharing a corner), 8 (opposite).
   // (The classic table; its entries sum to 420: ∫ (Σ N)² = V.)
-  const std::array<std::array<int, 2>, 6> edges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+  const auto& edges = kQuadraticTetEdges;
   const auto touches = [&](int e, int corner) { return edges[e][0] == corner || edges[e][1] == corner; };
   const Eigen::Matrix<double, 10, 10>& m = quadraticReferenceMass();
   for (int a = 0; a < 10; ++a)

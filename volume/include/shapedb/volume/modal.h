@@ -45,6 +45,9 @@ struct QuadraticTetMesh {
   std::size_t nodeCount() const { return nodes.size(); }
 };
 QuadraticTetMesh makeQuadratic(const core::TetMesh& mesh);
+/// The corners at the ends of the edges of QuadraticTetMesh::Tet, in order (nodes 4–9).
+inline constexpr std::array<std::array<int, 2>, 6> kQuadraticTetEdges{
+    {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
 
 /// Shape functions of the 10-node tet at barycentric coordinates `l`: gradients (columns, node order of
 /// QuadraticTetMesh::Tet) from the gradients of the barycentric coordinates (core::tetGradients).
