@@ -264,9 +264,10 @@ Command addBuildCommand(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
       "build",
       "Build a shape database (paper §3.1) into one SQLite file: for each shape of the families' sweeps, a\n"
-      "TetGen tet mesh, mass properties, the three descriptors, the first M vibration modes (linear FEM,\n"
-      "unit density and Young's modulus), a collision compound and sound data. Runs on all cores; commits\n"
-      "every --batch entries, so an interrupted build loses little: continue it with --resume.");
+      "TetGen tet mesh, mass properties, the three descriptors, the first M vibration modes (FEM on linear\n"
+      "or quadratic tets, unit density and Young's modulus), a collision compound and sound data. Runs on\n"
+      "all cores; commits every --batch entries, so an interrupted build loses little: continue it with\n"
+      "--resume.");
   app->add_option("DB", o->path, "Database file to create (or to continue, with --resume)")->required();
   app->add_option("--entries", o->entries, "Entries in the catalog, spread evenly over the families")
       ->capture_default_str()

@@ -28,6 +28,7 @@ constexpr std::size_t kCentroidVoxelIndex = 2, kEllipsoidIndex = 3, kBoxIndex = 
 void frequencyErrors(MethodEvaluation& m, const Eigen::VectorXd& f, const Eigen::VectorXd& truth, int n) {
   n = std::min<int>({n, static_cast<int>(f.size()), static_cast<int>(truth.size())});
   m.frequenciesHz = f.head(n);
+  m.firstFrequencyError = m.meanFrequencyError = m.maxFrequencyError = MethodEvaluation::kNaN;
   if (n == 0) return;
   m.firstFrequencyError = (f[0] - truth[0]) / truth[0];
   double sum = 0.0, worst = 0.0;
@@ -280,7 +281,9 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
           // The centroid-voxel match, stretched to the shape's proportions before it is adapted.
           MethodEvaluation stretch = e.methods[kCentroidVoxelIndex];
           stretch.method = EvaluationMethod::kCentroidVoxelStretched;
-          stretch.queryMicros += stretched[i].micros;
+          stretch.queryMicros = database.supportsStretchCorrection()
+                                    ? stretch.queryMicros + stretched[i].micros
+                                    : MethodEvaluation::kNaN;  // not evaluated: no time, no errors
           frequencyErrors(stretch, stretched[i].frequenciesHz, e.truthFrequenciesHz, options.frequencies);
           e.methods.push_back(std::move(stretch));
         }
@@ -305,6 +308,7 @@ std::vector<MethodSummary> summarize(std::span<const FragmentEvaluation> evaluat
     for (const FragmentEvaluation& e : evaluations) {
       if (!e.ok() || e.methods.size() <= k) continue;
       const MethodEvaluation& m = e.methods[k];
+      if (!std::isfinite(m.firstFrequencyError)) continue;  // not evaluated (the stretch, on quadratic tets)
       ++s.count;
       first.push_back(std::abs(m.firstFrequencyError));
       mean.push_back(m.meanFrequencyError);
@@ -372,7 +376,8 @@ Status writeEvaluationSummary(std::span<const FragmentEvaluation> evaluations, c
   file << "# " << title << "\n\n";
   file << ok << " of " << evaluations.size()
        << " shapes evaluated. Errors are against the data computed directly on each shape with the "
-          "database's own pipeline and parameters (TetGen, linear FEM, shift-invert Lanczos).\n\n";
+          "database's own pipeline and parameters (TetGen, FEM on the tets the title names, shift-invert "
+          "Lanczos).\n\n";
   Eigen::Index frequencyCount = 0;
   for (const FragmentEvaluation& e : evaluations)
     if (e.ok()) frequencyCount = std::max(frequencyCount, e.truthFrequenciesHz.size());
@@ -380,6 +385,10 @@ Status writeEvaluationSummary(std::span<const FragmentEvaluation> evaluations, c
        << frequencyCount << " | median collision-proxy IoU | median query |\n";
   file << "|---|---:|---:|---:|---:|---:|---:|\n";
   for (const MethodSummary& s : summarize(evaluations)) {
+    if (s.count == 0) {
+      file << "| " << toString(s.method) << " | 0 | n/a | n/a | n/a | n/a | n/a |\n";
+      continue;
+    }
     std::snprintf(line, sizeof line, "| %s | %zu | %.1f %% | %.1f %% | %.1f %% | %.3f | %s |\n",
                   toString(s.method), s.count, 100.0 * s.medianFirstError, 100.0 * s.p90FirstError,
                   100.0 * s.medianMeanError, s.medianIou,
@@ -461,14 +470,16 @@ Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
     std::size_t j = 0;
     std::vector<double> errors;
     for (const FragmentEvaluation& e : evaluations) {
-      if (!e.ok() || e.methods.size() <= k) continue;
+      if (!e.ok() || e.methods.size() <= k || !std::isfinite(e.methods[k].firstFrequencyError)) continue;
       const double jitter = 0.3 * (std::fmod(0.6180339887 * static_cast<double>(++j), 1.0) - 0.5);
       dots.x.push_back(static_cast<double>(k) + jitter);
       dots.y.push_back(100.0 * std::abs(e.methods[k].firstFrequencyError));
       errors.push_back(dots.y.back());
     }
-    medians.x.push_back(static_cast<double>(k));
-    medians.y.push_back(median(errors));
+    if (!errors.empty()) {
+      medians.x.push_back(static_cast<double>(k));
+      medians.y.push_back(median(errors));
+    }
     errorSeries.push_back(std::move(dots));
   }
   errorSeries.push_back(std::move(medians));

@@ -1,6 +1,8 @@
 // The database subcommands as a user runs them: the real executable, a real file, a real SIGKILL.
 
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <signal.h>
 #include <sys/wait.h>
 #include <thread>
@@ -264,7 +266,8 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
   // The first box entry's own surface, queried in unit material: its frequencies are those of quadratic
   // tets computed directly on the same surface (same TetGen options, so the same mesh).
   const core::TriangleMesh surface = *volume::makeFamilyShape(volume::familySpec(volume::Family::kBox, 0));
-  const auto mesh = dir / "box.ply";
+  std::filesystem::create_directories(dir / "queries");
+  const auto mesh = dir / "queries" / "box.ply";
   ASSERT_TRUE(io::saveMesh(surface, mesh).ok());
   test::ProcessResult q = test::runProcess(SHAPEDB_CLI, {"query", db.string(), mesh.string(), "--density",
                                                          "1", "--youngs", "1", "--poisson", "0.3", "--json"});
@@ -287,6 +290,18 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
       test::runProcess(SHAPEDB_CLI, {"query", db.string(), mesh.string(), "--stretch"});
   EXPECT_NE(stretched.exitCode, 0);
   EXPECT_NE(stretched.err.find("needs a database of linear tets"), std::string::npos) << stretched.err;
+  // The benchmark leaves the stretched column empty, not a copy of the uniform one.
+  test::ProcessResult bench =
+      test::runProcess(SHAPEDB_CLI, {"bench", db.string(), "--queries", (dir / "queries").string(), "--out",
+                                     (dir / "bench").string(), "--frequencies", "4"});
+  ASSERT_EQ(bench.exitCode, 0) << bench.err;
+  std::ifstream summaryFile(dir / "bench" / "summary.md");
+  const std::string summary((std::istreambuf_iterator<char>(summaryFile)), {});
+  EXPECT_NE(summary.find("quadratic tets), steel; truth and baselines on quadratic tets"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("| centroid-voxel | 1 |"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("| centroid-voxel-stretched | 0 | n/a |"), std::string::npos) << summary;
+
   // An unknown order, and a resume that would change it.
   test::ProcessResult cubic =
       test::runProcess(SHAPEDB_CLI, {"build", (dir / "x.db").string(), "--elements", "cubic"});
