@@ -3,5 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
+start=$SECONDS
 scripts/setup.sh "$preset"
+echo "test: set up and built in $((SECONDS - start)) s"
 ctest --preset "$preset"
