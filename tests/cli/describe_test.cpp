@@ -12,7 +12,9 @@
 namespace shapedb {
 namespace {
 
-test::ProcessResult shapedb(const std::vector<std::string>& args) {
+// `shapedb describe ARGS...`
+test::ProcessResult runDescribe(std::vector<std::string> args) {
+  args.insert(args.begin(), "describe");
   return test::runProcess(SHAPEDB_CLI, args);
 }
 
@@ -20,7 +22,7 @@ TEST(CliDescribe, JsonHoldsTheGridTheLibraryComputes) {
   test::ScratchDir dir("cli");
   ASSERT_TRUE(io::saveMesh(test::makeLopsidedBlob({1.0, 1.6, 0.7}, 3), dir / "blob.ply").ok());
   const test::ProcessResult run =
-      shapedb({"describe", (dir / "blob.ply").string(), "--json", "--grid", "8", "--sampling", "vertices"});
+      runDescribe({(dir / "blob.ply").string(), "--json", "--grid", "8", "--sampling", "vertices"});
   ASSERT_EQ(run.exitCode, 0) << run.err;
   const nlohmann::json j = nlohmann::json::parse(run.out);
   EXPECT_EQ(j["descriptor"], "centroid-voxel");
@@ -55,7 +57,7 @@ TEST(CliDescribe, MomentAndVoxelCarryTheirFields) {
   test::ScratchDir dir("cli");
   ASSERT_TRUE(io::saveMesh(test::makeLopsidedBlob({1.0, 1.6, 0.7}, 2), dir / "blob.obj").ok());
   const test::ProcessResult moment =
-      shapedb({"describe", (dir / "blob.obj").string(), "--json", "--descriptor", "moment"});
+      runDescribe({(dir / "blob.obj").string(), "--json", "--descriptor", "moment"});
   ASSERT_EQ(moment.exitCode, 0) << moment.err;
   const nlohmann::json m = nlohmann::json::parse(moment.out);
   ASSERT_EQ(m["moments"].size(), 3u);
@@ -63,13 +65,13 @@ TEST(CliDescribe, MomentAndVoxelCarryTheirFields) {
   EXPECT_FALSE(m.contains("occupancy"));
 
   const test::ProcessResult voxel =
-      shapedb({"describe", (dir / "blob.obj").string(), "--json", "--descriptor", "voxel"});
+      runDescribe({(dir / "blob.obj").string(), "--json", "--descriptor", "voxel"});
   ASSERT_EQ(voxel.exitCode, 0) << voxel.err;
   const nlohmann::json v = nlohmann::json::parse(voxel.out);
   EXPECT_EQ(v["occupancy"].size(), 1000u);
   EXPECT_FALSE(v.contains("centroids"));
 
-  const test::ProcessResult text = shapedb({"describe", (dir / "blob.obj").string()});
+  const test::ProcessResult text = runDescribe({(dir / "blob.obj").string()});
   ASSERT_EQ(text.exitCode, 0) << text.err;
   EXPECT_NE(text.out.find("z=0"), std::string::npos);
   EXPECT_NE(text.out.find('#'), std::string::npos);
@@ -77,12 +79,12 @@ TEST(CliDescribe, MomentAndVoxelCarryTheirFields) {
 
 TEST(CliDescribe, BadInputAndBadOptionsAreReported) {
   test::ScratchDir dir("cli");
-  const test::ProcessResult missing = shapedb({"describe", (dir / "nope.obj").string()});
+  const test::ProcessResult missing = runDescribe({(dir / "nope.obj").string()});
   EXPECT_EQ(missing.exitCode, 1);
   EXPECT_NE(missing.err.find("nope.obj"), std::string::npos) << missing.err;
   ASSERT_TRUE(io::saveMesh(test::makeLopsidedBlob({1.0, 1.6, 0.7}, 1), dir / "blob.obj").ok());
-  EXPECT_EQ(shapedb({"describe", (dir / "blob.obj").string(), "--grid", "1"}).exitCode, 2);
-  EXPECT_EQ(shapedb({"describe", (dir / "blob.obj").string(), "--descriptor", "fourier"}).exitCode, 2);
+  EXPECT_EQ(runDescribe({(dir / "blob.obj").string(), "--grid", "1"}).exitCode, 2);
+  EXPECT_EQ(runDescribe({(dir / "blob.obj").string(), "--descriptor", "fourier"}).exitCode, 2);
 }
 
 }  // namespace
