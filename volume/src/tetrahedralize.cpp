@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -93,6 +94,16 @@ bool sendAll(int fd, const void* data, std::size_t bytes) {
 
 using Deadline = std::chrono::steady_clock::time_point;
 
+// testing::killNextTetGenWorkers: how many requests are still to find their worker killed.
+std::atomic<int> gWorkersToKill{0};
+
+bool takeInjectedKill() {
+  int left = gWorkersToKill.load();
+  while (left > 0 && !gWorkersToKill.compare_exchange_weak(left, left - 1)) {
+  }
+  return left > 0;
+}
+
 /// Receives exactly `bytes`, waiting until the deadline. False on end of stream, error or timeout.
 bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline, bool& timedOut) {
   char* p = static_cast<char*>(data);
@@ -153,6 +164,7 @@ class TetGenWorker {
   Result<RawResult> run(const TriangleMesh& surface, const std::string& switches, double timeout) {
     if (mPid <= 0)
       if (Status st = start(); !st) return st.error();
+    if (takeInjectedKill()) ::kill(mPid, SIGKILL);
     const Deadline deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(timeout));
@@ -374,20 +386,27 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // nearly so (a simplified level-set mesh: the volume changed by 1e-6), or aborts on it. Such a run is
   // repeated without merging ('M'); not always: TetGen 1.5 aborts with 'M' on some exactly coplanar
   // input (a box).
-  auto attempt = [&](const TetrahedralizeOptions& o) {
+  // One run. A guarded run whose worker died or hung (rather than TetGen answering) is repeated once in a
+  // fresh worker, so that a broken worker never changes the mesh. (Under ASan on a loaded machine a
+  // worker hung until its timeout now and then; the unmerged run that followed gave another mesh, and a
+  // resumed database differed from a clean one.)
+  auto once = [&](const TetrahedralizeOptions& o, bool mergeFacets) {
     bool moved = false;
-    Result<TetMesh> result = tetrahedralizeOnce(surface, o, *mass, /*mergeFacets=*/true, moved);
+    Result<TetMesh> result = tetrahedralizeOnce(surface, o, *mass, mergeFacets, moved);
+    if (!result && result.error().code == ErrorCode::kIo && o.guarded && o.relaxOnFailure)
+      result = tetrahedralizeOnce(surface, o, *mass, mergeFacets, moved);
+    return result;
+  };
+  auto attempt = [&](const TetrahedralizeOptions& o) {
+    Result<TetMesh> result = once(o, /*mergeFacets=*/true);
     if (!result) {
-      Result<TetMesh> unmerged = tetrahedralizeOnce(surface, o, *mass, /*mergeFacets=*/false, moved);
+      Result<TetMesh> unmerged = once(o, /*mergeFacets=*/false);
       if (unmerged) result = std::move(unmerged);
     }
     return result;
   };
   Result<TetMesh> tets = attempt(options);
   if (!options.relaxOnFailure) return tets;
-  // The guarded worker died or hung: the same request once more in a fresh worker first, so that a broken
-  // worker (rather than TetGen's answer) never changes the mesh.
-  if (!tets && tets.error().code == ErrorCode::kIo && options.guarded) tets = attempt(options);
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
   // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
   for (double relaxed : {2.5, 0.0}) {
@@ -400,5 +419,11 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   }
   return tets;
 }
+
+namespace testing {
+void killNextTetGenWorkers(int count) {
+  gWorkersToKill.store(std::max(count, 0));
+}
+}  // namespace testing
 
 }  // namespace shapedb::volume

@@ -45,4 +45,11 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, 
 Result<core::TetMesh> tetrahedralize(const core::TriangleMesh& surface,
                                      const TetrahedralizeOptions& options = {});
 
+namespace testing {
+/// Fault injection, for tests: the guarded worker of each of the next `count` TetGen requests (in any
+/// thread of this process) is killed before it gets the request, as a crash or a hang of the worker
+/// itself would leave it.
+void killNextTetGenWorkers(int count);
+}  // namespace testing
+
 }  // namespace shapedb::volume
