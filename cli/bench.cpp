@@ -105,7 +105,8 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
   const std::filesystem::path out(o.out);
   const std::string source = o.queries.empty()
                                  ? o.fractureMesh + " broken into " + std::to_string(shapes->size()) +
-                                       " fragments (seed " + std::to_string(o.fracture.seed) + ")"
+                                       " fragments (seed " + std::to_string(o.fracture.seed) +
+                                       ", --max-triangles " + std::to_string(o.fracture.maxTriangles) + ")"
                                  : o.queries;
   const std::string title =
       "shapedb bench: " + source + ", against " + o.database + " (" + std::to_string(db->entries().size()) +

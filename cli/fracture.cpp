@@ -71,6 +71,11 @@ void addFractureFlags(CLI::App& app, volume::FractureOptions& options) {
   app.add_option("--resolution", options.resolution, "Level-set voxels along the mesh's longest side")
       ->capture_default_str()
       ->check(CLI::Range(16, 1024));
+  app.add_option("--max-triangles", options.maxTriangles,
+                 "Simplify each fragment to this many triangles, as far as moving its surface by at most a\n"
+                 "quarter voxel allows (fewer: coarser fragments, and far fewer tets computed directly)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{100}, std::size_t{1'000'000}));
 }
 
 Command addFractureCommand(CLI::App& parent) {

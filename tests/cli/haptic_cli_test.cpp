@@ -1,6 +1,7 @@
 // shapedb haptic as a user runs it: the real executable on a real database, a scene directory of mesh
 // files and a CSV trajectory; its JSON report parsed back.
 
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -9,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
@@ -126,6 +128,35 @@ TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoo
     EXPECT_TRUE(mesh->topology.isClosed()) << file;
     EXPECT_EQ(readAll(file), readAll(again / file.filename())) << file.filename();
   }
+
+  // --max-triangles: the same fragments, coarser (and still closed); a count under 100 is refused.
+  const auto coarse = dir / "coarse";
+  test::ProcessResult few = test::runProcess(
+      SHAPEDB_CLI, {"fracture", plate.string(), "--pieces", "6", "--seed", "3", "--resolution", "48",
+                    "--max-triangles", "200", "--out", coarse.string()});
+  ASSERT_EQ(few.exitCode, 0) << few.err;
+  std::size_t fine = 0, coarseTotal = 0;
+  double fineVolume = 0.0, coarseVolume = 0.0;
+  for (const auto& file : files) {
+    auto full = io::loadMesh(file);
+    auto reduced = io::loadMesh(coarse / file.filename());
+    ASSERT_TRUE(full.ok() && reduced.ok()) << file.filename();
+    EXPECT_TRUE(reduced->topology.isClosed()) << file.filename();
+    fine += full->mesh.triangleCount();
+    coarseTotal += reduced->mesh.triangleCount();
+    fineVolume += core::computeMassProperties(full->mesh)->volume;
+    coarseVolume += core::computeMassProperties(reduced->mesh)->volume;
+  }
+  EXPECT_EQ(static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(coarse),
+                                                   std::filesystem::directory_iterator())),
+            files.size());
+  EXPECT_NEAR(coarseVolume, fineVolume, 0.02 * fineVolume);
+  std::printf("fragments: %zu triangles, %zu with --max-triangles 200\n", fine, coarseTotal);
+  EXPECT_LT(coarseTotal, fine);
+  EXPECT_EQ(test::runProcess(SHAPEDB_CLI, {"fracture", plate.string(), "--max-triangles", "50", "--out",
+                                           (dir / "x").string()})
+                .exitCode,
+            2);
 
   const auto db = dir / "small.db";
   ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "8", "--families", "shard,box",
