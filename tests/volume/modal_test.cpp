@@ -271,8 +271,8 @@ TEST(Tetrahedralize, GuardedAndInProcessGiveTheSameMesh) {
 
 // A worker that dies (or hangs) costs its request only: the same request is repeated in a fresh worker,
 // and the mesh is the one a healthy worker gives. These boxes are the first of the catalog a build of 24
-// entries makes; for box-00005 the run without facet merging, which used to follow a dead worker, gives
-// another mesh (a resumed database then differed from a clean one under ASan).
+// entries makes; for them the run without facet merging, which used to follow a dead worker, gives
+// another mesh (box-00005's made a resumed database differ from a clean one under ASan).
 TEST(Tetrahedralize, AWorkerThatDiesDoesNotChangeTheMesh) {
   const std::vector<Family> families = {Family::kBox, Family::kCone, Family::kShard};
   for (const ShapeSpec& spec : buildCatalog(24, families)) {

@@ -326,10 +326,9 @@ void dropSlivers(TetMesh& mesh) {
 }
 
 /// One TetGen run with these switches, its output checked and turned positive, and checked to fill the
-/// surface: same volume and centroid to 1e-9 (relative). `moved` says when that last check failed.
+/// surface: same volume and centroid to 1e-9 (relative).
 Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const TetrahedralizeOptions& options,
-                                   const core::MassProperties& mass, bool mergeFacets, bool& moved) {
-  moved = false;
+                                   const core::MassProperties& mass, bool mergeFacets) {
   const double volume = mass.volume;
   const std::string switches = tetgenSwitches(options, volume, mergeFacets);
   RawResult raw;
@@ -363,7 +362,6 @@ Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const Tetrahedra
   const core::MassProperties filled = core::computeTetMassProperties(mesh);
   if (std::abs(filled.volume - volume) > 1e-9 * volume ||
       (filled.centerOfMass - mass.centerOfMass).norm() > 1e-9 * std::cbrt(volume)) {
-    moved = true;
     return Error{ErrorCode::kParse, "TetGen moved the surface: its tets hold " +
                                         std::to_string(filled.volume / volume) + " of the volume"};
   }
@@ -391,10 +389,9 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // worker hung until its timeout now and then; the unmerged run that followed gave another mesh, and a
   // resumed database differed from a clean one.)
   auto once = [&](const TetrahedralizeOptions& o, bool mergeFacets) {
-    bool moved = false;
-    Result<TetMesh> result = tetrahedralizeOnce(surface, o, *mass, mergeFacets, moved);
+    Result<TetMesh> result = tetrahedralizeOnce(surface, o, *mass, mergeFacets);
     if (!result && result.error().code == ErrorCode::kIo && o.guarded && o.relaxOnFailure)
-      result = tetrahedralizeOnce(surface, o, *mass, mergeFacets, moved);
+      result = tetrahedralizeOnce(surface, o, *mass, mergeFacets);
     return result;
   };
   auto attempt = [&](const TetrahedralizeOptions& o) {
