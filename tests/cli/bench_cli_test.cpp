@@ -90,8 +90,7 @@ TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
       EXPECT_TRUE(row[column["speedup"]].empty());
     }
   }
-  std::ifstream md(out / "summary.md");
-  const std::string summary((std::istreambuf_iterator<char>(md)), {});
+  const std::string summary = test::readFile(out / "summary.md");
   EXPECT_NE(summary.find("glass"), std::string::npos);
   EXPECT_NE(summary.find("faster"), std::string::npos);
   for (const char* png : {"time.png", "error.png"}) {

@@ -1,8 +1,6 @@
 // The database subcommands as a user runs them: the real executable, a real file, a real SIGKILL.
 
 #include <chrono>
-#include <fstream>
-#include <iterator>
 #include <signal.h>
 #include <sys/wait.h>
 #include <thread>
@@ -295,8 +293,7 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
       test::runProcess(SHAPEDB_CLI, {"bench", db.string(), "--queries", (dir / "queries").string(), "--out",
                                      (dir / "bench").string(), "--frequencies", "4"});
   ASSERT_EQ(bench.exitCode, 0) << bench.err;
-  std::ifstream summaryFile(dir / "bench" / "summary.md");
-  const std::string summary((std::istreambuf_iterator<char>(summaryFile)), {});
+  const std::string summary = test::readFile(dir / "bench" / "summary.md");
   EXPECT_NE(summary.find("quadratic tets), steel; truth and baselines on quadratic tets"), std::string::npos)
       << summary;
   EXPECT_NE(summary.find("| centroid-voxel | 1 |"), std::string::npos) << summary;

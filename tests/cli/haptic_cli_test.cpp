@@ -101,11 +101,6 @@ TEST(HapticCli, ReportParsedBackForASceneWithAnOpenMesh) {
   EXPECT_TRUE(s["augmentation_latency_ms"].contains("p99"));
 }
 
-std::string readAll(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoop) {
   test::ScratchDir dir("fracture-cli");
   const auto plate = dir / "plate.obj";
@@ -126,7 +121,7 @@ TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoo
     auto mesh = io::loadMesh(file);
     ASSERT_TRUE(mesh.ok()) << mesh.error().message;
     EXPECT_TRUE(mesh->topology.isClosed()) << file;
-    EXPECT_EQ(readAll(file), readAll(again / file.filename())) << file.filename();
+    EXPECT_EQ(test::readFile(file), test::readFile(again / file.filename())) << file.filename();
   }
 
   // --max-triangles: the same fragments, coarser (and still closed); a count under 100 is refused.

@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -48,6 +50,11 @@ ScratchDir::~ScratchDir() {
 void writeFile(const std::filesystem::path& path, const std::string& content) {
   std::ofstream out(path, std::ios::binary);
   out.write(content.data(), static_cast<std::streamsize>(content.size()));
+}
+
+std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace shapedb::test

@@ -41,4 +41,7 @@ class ScratchDir {
 /// Writes `content` to `path` byte for byte.
 void writeFile(const std::filesystem::path& path, const std::string& content);
 
+/// The whole of `path`, byte for byte ("" if it cannot be read).
+std::string readFile(const std::filesystem::path& path);
+
 }  // namespace shapedb::test
