@@ -272,8 +272,9 @@ Command addBuildCommand(CLI::App& parent) {
   app->add_option("--entries", o->entries, "Entries in the catalog, spread evenly over the families")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{10'000'000}));
-  app->add_option("--families", o->families,
-                  "Comma-separated families: box, ellipsoid, cylinder, cone, capsule, prism, shard; or all")
+  app->add_option(
+         "--families", o->families,
+         "Comma-separated families: box, ellipsoid, cylinder, cone, capsule, prism, shard, fragment; or all")
       ->capture_default_str();
   app->add_option("--modes", o->modes, "Non-rigid vibration modes per entry")
       ->capture_default_str()

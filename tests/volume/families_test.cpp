@@ -45,14 +45,49 @@ TEST(Families, SweepParametersStayInTheirDomainAndCatalogSplitsEvenly) {
     names.insert(s.name());
   EXPECT_EQ(names.size(), 4500u);
   EXPECT_EQ(catalog.front().name(), "box-00000");
-  EXPECT_EQ(catalog.back().name(), "shard-00641");  // 4500 = 7 × 642 + 6: the first six take one more
+  EXPECT_EQ(catalog.back().name(), "fragment-00561");  // 4500 = 8 × 562 + 4: the first four take one more
+}
+
+// A fragment is one Voronoi cell of its solid: convex (every vertex on the inner side of every face's
+// plane), inside the solid's box (1, a, b), and smaller than the solid (the seeds are at least four).
+TEST(Families, FragmentsAreConvexCellsInsideTheirSolid) {
+  std::set<int> pieces;
+  for (std::uint32_t i = 0; i < 60; ++i) {
+    const ShapeSpec spec = familySpec(Family::kFragment, i);
+    const double a = spec.params.x(), b = spec.params.y();
+    ASSERT_GE(a, b) << spec.name();
+    ASSERT_GE(b, 0.04 - 1e-12) << spec.name();
+    ASSERT_LE(a, 1.0) << spec.name();
+    ASSERT_GE(spec.params.z(), 4.0) << spec.name();
+    ASSERT_LT(spec.params.z(), 100.0) << spec.name();
+    pieces.insert(static_cast<int>(spec.params.z()));
+    auto mesh = makeFamilyShape(spec);
+    ASSERT_TRUE(mesh.ok()) << spec.name();
+    const core::Vec3 half(1.0, a, b);
+    for (const core::Vec3& p : mesh->vertices)
+      ASSERT_TRUE((p.cwiseAbs().array() <= half.array() + 1e-9).all())
+          << spec.name() << ": " << p.transpose();
+    // Vertices sit on a 2⁻³⁰ lattice, so the planes of sliver triangles are noise: judge by the others.
+    const auto mass = core::computeMassProperties(*mesh);
+    ASSERT_TRUE(mass.ok()) << spec.name();
+    for (const auto& t : mesh->triangles) {
+      const core::Vec3& p0 = mesh->vertices[t[0]];
+      const core::Vec3 cross = (mesh->vertices[t[1]] - p0).cross(mesh->vertices[t[2]] - p0);
+      if (cross.norm() < 1e-3 * mass->area) continue;
+      for (const core::Vec3& p : mesh->vertices)
+        ASSERT_LE(cross.normalized().dot(p - p0), 1e-7) << spec.name() << ": not convex";
+    }
+    const double solidVolume = 8.0 * a * b;  // the box; the ellipsoid and cylinder are smaller
+    EXPECT_LT(mass->volume, solidVolume) << spec.name();
+  }
+  EXPECT_GT(pieces.size(), 20u);  // the counts vary, not one value for every fragment
 }
 
 TEST(Families, ParseFamiliesNamesTheBadOne) {
   auto ok = parseFamilies("box,shard");
   ASSERT_TRUE(ok.ok());
   EXPECT_EQ(ok->size(), 2u);
-  EXPECT_EQ(parseFamilies("all")->size(), 7u);
+  EXPECT_EQ(parseFamilies("all")->size(), 8u);
   auto bad = parseFamilies("box,torus");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("'torus'"), std::string::npos);

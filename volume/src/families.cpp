@@ -21,10 +21,15 @@ using detail::clip;
 using detail::Polygon;
 using detail::triangulate;
 
-constexpr std::array kGenerated = {Family::kBox,     Family::kEllipsoid, Family::kCylinder, Family::kCone,
-                                   Family::kCapsule, Family::kPrism,     Family::kShard};
+constexpr std::array kGenerated = {Family::kBox,   Family::kEllipsoid, Family::kCylinder,
+                                   Family::kCone,  Family::kCapsule,   Family::kPrism,
+                                   Family::kShard, Family::kFragment};
 constexpr double kMinRatio = 0.1;    ///< thinnest side over the largest
 constexpr double kMaxLength = 10.0;  ///< longest axial length over the cross-section
+// Fragments: the broken solid's thinnest side over its largest (a 40 × 30 × 2 cm plate is 0.05), and the
+// number of Voronoi seeds it is broken with.
+constexpr double kMinFragmentSourceRatio = 0.04;
+constexpr double kMinPieces = 4.0, kMaxPieces = 100.0;
 
 /// Martin Roberts' R2 sequence: the plastic number's powers give the most even 2-D coverage of any
 /// additive recurrence. Point i in [0, 1)².
@@ -67,6 +72,73 @@ TriangleMesh makeShard(std::uint64_t seed) {
   }
 }
 
+/// The convex solids fragments are broken from, semi-axes (1, a, b): a box, or an ellipsoid or elliptic
+/// cylinder along z as the box cut by tangent planes (planar polygon faces throughout: a triangulated
+/// curved surface, clipped, leaves fan slivers that TetGen crashes on).
+enum class FragmentSolid { kBox, kEllipsoid, kCylinder };
+
+std::vector<Polygon> fragmentSolid(FragmentSolid kind, const Vec3& half) {
+  std::vector<Polygon> faces = detail::boxFaces(-half, half);
+  const auto cutTangent = [&](const Vec3& unitPoint) {  // the tangent plane at half ⊙ unitPoint
+    const Vec3 n = unitPoint.cwiseQuotient(half);
+    faces = clip(faces, n, n.dot(unitPoint.cwiseProduct(half)));
+  };
+  if (kind == FragmentSolid::kEllipsoid) {
+    constexpr int kPlanes = 96;  // a Fibonacci sphere of directions
+    for (int i = 0; i < kPlanes; ++i) {
+      const double z = 1.0 - (2.0 * i + 1.0) / kPlanes, r = std::sqrt(1.0 - z * z);
+      const double phi = i * std::numbers::pi * (3.0 - std::sqrt(5.0));
+      cutTangent(Vec3(r * std::cos(phi), r * std::sin(phi), z));
+    }
+  } else if (kind == FragmentSolid::kCylinder) {
+    constexpr int kPlanes = 24;
+    for (int i = 0; i < kPlanes; ++i) {
+      const double phi = 2.0 * std::numbers::pi * (i + 0.5) / kPlanes;
+      cutTangent(Vec3(std::cos(phi), std::sin(phi), 0.0));
+    }
+  }
+  return faces;
+}
+
+bool insideFragmentSolid(FragmentSolid kind, const Vec3& half, const Vec3& p) {
+  const Vec3 u = p.cwiseQuotient(half);
+  switch (kind) {
+    case FragmentSolid::kBox:
+      return true;  // drawn in the box
+    case FragmentSolid::kEllipsoid:
+      return u.squaredNorm() <= 1.0;
+    case FragmentSolid::kCylinder:
+      return u.head<2>().squaredNorm() <= 1.0;
+  }
+  return false;
+}
+
+/// A fragment as fracture makes it: the Voronoi cell of the first of `pieces` seeds drawn uniformly inside
+/// a convex solid (by index mod 3: box, ellipsoid, cylinder; the plates, slabs, bars, balls and discs that
+/// get broken), clipped to the solid. Cells of seeds near the surface keep part of it; the others are cut
+/// on every side. Redrawn from the same generator, as shards are, when a cell is a sliver the mesh checks
+/// refuse.
+TriangleMesh makeFragment(const ShapeSpec& spec) {
+  std::mt19937_64 rng(spec.index * 0xD1B54A32D192ED03ull + 0xF4A9);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Vec3 half(1.0, spec.params.x(), spec.params.y());
+  const int pieces = static_cast<int>(spec.params.z());
+  const auto kind = static_cast<FragmentSolid>(spec.index % 3);
+  const std::vector<Polygon> solid = fragmentSolid(kind, half);
+  for (;;) {
+    std::vector<Vec3> seeds;
+    while (static_cast<int>(seeds.size()) < pieces) {
+      const Vec3 p =
+          Vec3(2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0).cwiseProduct(half);
+      if (insideFragmentSolid(kind, half, p)) seeds.push_back(p);
+    }
+    const std::vector<Polygon> cell = detail::voronoiCell(solid, seeds, 0);
+    if (cell.size() < 4) continue;
+    TriangleMesh mesh = triangulate(cell);
+    if (core::validateMesh(mesh).ok() && core::analyzeTopology(mesh).isClosed()) return mesh;
+  }
+}
+
 }  // namespace
 
 std::span<const Family> generatedFamilies() {
@@ -89,6 +161,8 @@ const char* toString(Family family) {
       return "prism";
     case Family::kShard:
       return "shard";
+    case Family::kFragment:
+      return "fragment";
     case Family::kUser:
       return "user";
   }
@@ -97,7 +171,7 @@ const char* toString(Family family) {
 
 std::optional<Family> parseFamily(std::string_view name) {
   for (Family f : {Family::kBox, Family::kEllipsoid, Family::kCylinder, Family::kCone, Family::kCapsule,
-                   Family::kPrism, Family::kShard, Family::kUser})
+                   Family::kPrism, Family::kShard, Family::kFragment, Family::kUser})
     if (name == toString(f)) return f;
   return std::nullopt;
 }
@@ -112,7 +186,7 @@ Result<std::vector<Family>> parseFamilies(std::string_view list) {
     if (!f || *f == Family::kUser)
       return Error{ErrorCode::kInvalidArgument,
                    "unknown family '" + std::string(name) +
-                       "' (known: box, ellipsoid, cylinder, cone, capsule, prism, shard)"};
+                       "' (known: box, ellipsoid, cylinder, cone, capsule, prism, shard, fragment)"};
     if (std::find(families.begin(), families.end(), *f) != families.end())
       return Error{ErrorCode::kInvalidArgument, "family '" + std::string(name) + "' is listed twice"};
     families.push_back(*f);
@@ -147,6 +221,17 @@ ShapeSpec familySpec(Family family, std::uint32_t index) {
       spec.params =
           Vec3(std::exp(std::log(kMinRatio) * u), std::exp(std::log(kMaxLength) * (2.0 * v - 1.0)), 0.0);
       break;
+    case Family::kFragment: {
+      // Log-uniform proportions of the broken solid (folded, a ≥ b) and pieces; the count from the
+      // index's own stream, so that it does not line up with the R2 proportions.
+      const double s = std::exp(std::log(kMinFragmentSourceRatio) * u),
+                   t = std::exp(std::log(kMinFragmentSourceRatio) * v);
+      std::mt19937_64 rng(index * 0x9E3779B97F4A7C15ull + 0xF4A6);
+      const double w = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      spec.params = Vec3(std::max(s, t), std::min(s, t),
+                         std::floor(kMinPieces * std::exp(std::log(kMaxPieces / kMinPieces) * w)));
+      break;
+    }
     case Family::kShard:
     case Family::kUser:
       break;
@@ -185,6 +270,8 @@ Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolutio
       return core::makeTriangularPrism(2.0, 2.0 * a, 2.0 * b);
     case Family::kShard:
       return makeShard(spec.index);
+    case Family::kFragment:
+      return makeFragment(spec);
     case Family::kUser:
       break;
   }

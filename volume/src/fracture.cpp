@@ -127,16 +127,8 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   std::vector<std::vector<openvdb::FloatGrid::Ptr>> cellGrids(seeds.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seeds.size(), 1), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      std::vector<detail::Polygon> cell = detail::boxFaces(bounds.min - margin, bounds.max + margin);
-      for (std::size_t j = 0; j < seeds.size() && !cell.empty(); ++j) {
-        if (j == i) continue;
-        const Vec3 n = seeds[j] - seeds[i];
-        if (n.squaredNorm() == 0.0) {
-          if (j < i) cell.clear();  // a repeated seed: the first one takes the cell
-          continue;
-        }
-        cell = detail::clip(cell, n, n.dot(0.5 * (seeds[i] + seeds[j])));
-      }
+      const std::vector<detail::Polygon> cell =
+          detail::voronoiCell(detail::boxFaces(bounds.min - margin, bounds.max + margin), seeds, i);
       if (cell.size() < 4) continue;
       const TriangleMesh cutterMesh = detail::triangulate(cell);
       const core::Bounds cellBounds = core::computeBounds(cutterMesh);

@@ -69,6 +69,19 @@ std::vector<Polygon> clip(const std::vector<Polygon>& faces, const Vec3& n, doub
   return result;
 }
 
+std::vector<Polygon> voronoiCell(std::vector<Polygon> solid, std::span<const Vec3> seeds, std::size_t i) {
+  for (std::size_t j = 0; j < seeds.size() && !solid.empty(); ++j) {
+    if (j == i) continue;
+    const Vec3 n = seeds[j] - seeds[i];
+    if (n.squaredNorm() == 0.0) {
+      if (j < i) solid.clear();
+      continue;
+    }
+    solid = clip(solid, n, n.dot(0.5 * (seeds[i] + seeds[j])));
+  }
+  return solid;
+}
+
 TriangleMesh triangulate(const std::vector<Polygon>& faces) {
   TriangleMesh mesh;
   std::map<std::array<double, 3>, std::uint32_t> ids;

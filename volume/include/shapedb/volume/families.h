@@ -13,13 +13,24 @@
 
 namespace shapedb::volume {
 
-/// The shape families of the database (paper §6: six generic families; shards added for fracture), and
+/// The shape families of the database (paper §6: six generic families; shards and fragments added for
+/// fracture, the "scenario-based database" of the paper's §7), and
 /// `kUser` for the meshes `shapedb add` brings.
-enum class Family : std::uint8_t { kBox, kEllipsoid, kCylinder, kCone, kCapsule, kPrism, kShard, kUser };
+enum class Family : std::uint8_t {
+  kBox,
+  kEllipsoid,
+  kCylinder,
+  kCone,
+  kCapsule,
+  kPrism,
+  kShard,
+  kFragment,
+  kUser
+};
 
 /// The families a default build uses, in catalog order: all but kUser.
 std::span<const Family> generatedFamilies();
-/// "box", "ellipsoid", "cylinder", "cone", "capsule", "prism", "shard", "user".
+/// "box", "ellipsoid", "cylinder", "cone", "capsule", "prism", "shard", "fragment", "user".
 const char* toString(Family family);
 std::optional<Family> parseFamily(std::string_view name);
 /// A comma-separated list of family names ("box,cone"); "all" for generatedFamilies().
@@ -35,11 +46,14 @@ Result<std::vector<Family>> parseFamilies(std::string_view list);
 /// - cylinder, cone, capsule, prism: along z, cross-section aspect a ∈ [0.1, 1] (y over x), length over
 ///   cross-section size c ∈ [0.1, 10], both log-uniform;
 /// - shard: the seed of a random convex polyhedron (a cube cut by 6–14 random half-spaces, then
-///   stretched), params unused.
+///   stretched), params unused;
+/// - fragment: what fracture breaks off a solid: the Voronoi cell of one of p random seeds inside a box,
+///   an ellipsoid or an elliptic cylinder (by index mod 3) of semi-axes 1 ≥ a ≥ b ≥ 0.04, clipped to it;
+///   a and b log-uniform as for boxes, p log-uniform in [4, 100), the seeds from the index.
 struct ShapeSpec {
   Family family = Family::kBox;
   std::uint32_t index = 0;                 ///< position in the family's sweep
-  core::Vec3 params = core::Vec3::Zero();  ///< (a, c or b, 0); shards: zero
+  core::Vec3 params = core::Vec3::Zero();  ///< (a, c or b, 0); fragments (a, b, p); shards: zero
   /// "box-00017": unique within a database, stable across builds of any size.
   std::string name() const;
 };
