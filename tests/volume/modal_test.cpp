@@ -9,6 +9,7 @@
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/primitives.h>
+#include <shapedb/volume/entry.h>
 #include <shapedb/volume/families.h>
 #include <shapedb/volume/modal.h>
 #include <shapedb/volume/tetrahedralize.h>
@@ -257,6 +258,22 @@ TEST(Tetrahedralize, TetVolumeIntegralsEqualSurfaceIntegrals) {
     EXPECT_NEAR(core::computeSurfaceArea(core::boundarySurface(tets)), fromSurface->area,
                 1e-9 * fromSurface->area);
   }
+}
+
+// The tets an entry stores are in the canonical frame, and the database's reader refuses any tet that is
+// flat there (validateTetMesh). TetGen's flat tets are dropped in the input frame; fragment-00502 of
+// the default catalog kept one that the move to the canonical frame flattened by round-off, and the
+// built database could not read its entry back ("corrupted tet mesh blob").
+TEST(Tetrahedralize, AnEntrysTetsAreValidInTheCanonicalFrame) {
+  const ShapeSpec spec = familySpec(Family::kFragment, 502);
+  auto surface = makeFamilyShape(spec);
+  ASSERT_TRUE(surface.ok());
+  EntryOptions options;
+  options.modal.modes = 2;
+  auto entry = computeEntry(*surface, options);
+  ASSERT_TRUE(entry.ok()) << entry.error().message;
+  const Status valid = core::validateTetMesh(entry->physics.tetMesh);
+  EXPECT_TRUE(valid.ok()) << valid.error().message;
 }
 
 TEST(Tetrahedralize, GuardedAndInProcessGiveTheSameMesh) {

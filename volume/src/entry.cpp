@@ -58,6 +58,11 @@ Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOpt
   entry.physics.tetMesh = std::move(tets).value();
   for (core::Vec3& p : entry.physics.tetMesh.nodes)
     p = core::transformPoint(normalization->canonicalFromMesh, p);
+  // What the database stores must pass its reader's checks in this frame (fragment-00502 had a tet
+  // flattened by the move): the nearly flat ones go, and the fill check below still holds the rest.
+  dropFlatTets(entry.physics.tetMesh);
+  if (Status valid = core::validateTetMesh(entry.physics.tetMesh); !valid)
+    return Error{ErrorCode::kParse, "tetrahedralize: in the canonical frame, " + valid.error().message};
   entry.physics.massProperties = core::computeTetMassProperties(entry.physics.tetMesh);
   // The tets must fill the surface: unit volume, centre at the origin, in the canonical frame.
   const core::MassProperties& m = entry.physics.massProperties;

@@ -294,37 +294,6 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, 
 
 namespace {
 
-/// Removes the tets with no volume to speak of (under validateTetMesh's flatness bound) and the nodes left
-/// without a tet. A surface whose faces are only nearly coplanar (a level-set mesh: float coordinates)
-/// leaves wedges of 1e-18 of the volume between them, which TetGen fills with flat tets; their stiffness
-/// would be garbage, and their volume is below the fill check's tolerance by nine orders of magnitude.
-void dropSlivers(TetMesh& mesh) {
-  core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const core::Vec3& p : mesh.nodes) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const double minVolume = 1e-15 * std::pow((hi - lo).maxCoeff(), 3);
-  std::erase_if(mesh.tets, [&](const TetMesh::Tet& t) {
-    const core::Vec3& a = mesh.nodes[t[0]];
-    return !((mesh.nodes[t[1]] - a).cross(mesh.nodes[t[2]] - a).dot(mesh.nodes[t[3]] - a) / 6.0 > minVolume);
-  });
-  std::vector<std::int64_t> renumber(mesh.nodes.size(), -1);
-  for (const TetMesh::Tet& t : mesh.tets)
-    for (std::uint32_t v : t)
-      renumber[v] = 0;
-  std::size_t kept = 0;
-  for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
-    if (renumber[v] == 0) {
-      mesh.nodes[kept] = mesh.nodes[v];
-      renumber[v] = static_cast<std::int64_t>(kept++);
-    }
-  mesh.nodes.resize(kept);
-  for (TetMesh::Tet& t : mesh.tets)
-    for (std::uint32_t& v : t)
-      v = static_cast<std::uint32_t>(renumber[v]);
-}
-
 /// One TetGen run with these switches, its output checked and turned positive, and checked to fill the
 /// surface: same volume and centroid to 1e-9 (relative).
 Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const TetrahedralizeOptions& options,
@@ -356,7 +325,7 @@ Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const Tetrahedra
     // TetGen orients tets negatively in our convention (its manual's right-hand rule); make them positive.
     if (core::tetVolume(mesh, t) < 0.0) std::swap(mesh.tets[t][2], mesh.tets[t][3]);
   }
-  dropSlivers(mesh);
+  dropFlatTets(mesh);
   if (Status valid = core::validateTetMesh(mesh); !valid)
     return Error{ErrorCode::kParse, "TetGen returned an invalid mesh: " + valid.error().message};
   const core::MassProperties filled = core::computeTetMassProperties(mesh);
@@ -415,6 +384,36 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     tets = attempt(looser);
   }
   return tets;
+}
+
+// A surface whose faces are only nearly coplanar (a level-set mesh: float coordinates) leaves wedges of
+// 1e-18 of the volume between them, which TetGen fills with flat tets; their stiffness would be garbage,
+// and their volume is below the fill check's tolerance by nine orders of magnitude.
+void dropFlatTets(TetMesh& mesh) {
+  core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const core::Vec3& p : mesh.nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double minVolume = 1e-15 * std::pow((hi - lo).maxCoeff(), 3);
+  std::erase_if(mesh.tets, [&](const TetMesh::Tet& t) {
+    const core::Vec3& a = mesh.nodes[t[0]];
+    return !((mesh.nodes[t[1]] - a).cross(mesh.nodes[t[2]] - a).dot(mesh.nodes[t[3]] - a) / 6.0 > minVolume);
+  });
+  std::vector<std::int64_t> renumber(mesh.nodes.size(), -1);
+  for (const TetMesh::Tet& t : mesh.tets)
+    for (std::uint32_t v : t)
+      renumber[v] = 0;
+  std::size_t kept = 0;
+  for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
+    if (renumber[v] == 0) {
+      mesh.nodes[kept] = mesh.nodes[v];
+      renumber[v] = static_cast<std::int64_t>(kept++);
+    }
+  mesh.nodes.resize(kept);
+  for (TetMesh::Tet& t : mesh.tets)
+    for (std::uint32_t& v : t)
+      v = static_cast<std::uint32_t>(renumber[v]);
 }
 
 namespace testing {

@@ -45,6 +45,12 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, 
 Result<core::TetMesh> tetrahedralize(const core::TriangleMesh& surface,
                                      const TetrahedralizeOptions& options = {});
 
+/// Removes the tets with no volume to speak of (under validateTetMesh's flatness bound, 1e-15 of the
+/// mesh's extent cubed) and the nodes left without a tet. tetrahedralize does it to TetGen's output; a
+/// mesh moved to another frame needs it again, since round-off can flatten a tet that was just above
+/// the bound.
+void dropFlatTets(core::TetMesh& mesh);
+
 namespace testing {
 /// Fault injection, for tests: the guarded worker of each of the next `count` TetGen requests (in any
 /// thread of this process) is killed before it gets the request, as a crash or a hang of the worker
