@@ -12,6 +12,7 @@
 #include <shapedb/core/index.h>
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
+#include <shapedb/core/orientation.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/volume/describe.h>
 
@@ -213,6 +214,47 @@ TEST(Describe, SameDescriptorAndSelfMatchUnderThousandRandomSimilarities) {
       EXPECT_LT(worstCentroid, 1e-6);
     }
   }
+}
+
+// The describer's shortcuts (one cell, one plane, triangles split into triangles, polygons peeled slab by
+// slab) against the oracle that clips every triangle against every cell of its range on its own: random
+// shapes under random similarities, fine and coarse tessellations, several grid sizes, every orientation
+// candidate's frame (sign flips and turns).
+TEST(Describe, AreaSamplingAgreesWithClippingEveryCellOnItsOwn) {
+  std::mt19937_64 rng(77);
+  std::vector<TriangleMesh> shapes = {
+      test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 4),  // 5,120 small triangles
+      test::makeLopsidedBlob(Vec3(1.0, 0.3, 0.2), 1),  // 80 large ones
+      core::makeBox(Vec3(1.0, 0.5, 0.25)),             // faces on cell planes
+      core::makeUvEllipsoid(Vec3(1.0, 1.0, 0.4), 40, 20)};
+  for (int i = 0; i < 8; ++i)
+    shapes.push_back(test::makeRandomShape(rng, 1 + i % 3));
+  int compared = 0;
+  for (int grid : {10, 7, 23}) {
+    for (const TriangleMesh& shape : shapes) {
+      const TriangleMesh mesh = core::transformed(shape, test::randomSimilarity(rng));
+      const DescriptorOptions options =
+          test::descriptorOptions(DescriptorKind::kCentroidVoxel, Sampling::kArea, grid);
+      Result<core::MassProperties> mp = core::computeMassProperties(mesh);
+      ASSERT_TRUE(mp.ok());
+      Result<core::Normalization> n = core::normalize(mesh, *mp);
+      ASSERT_TRUE(n.ok());
+      Describer describer(options);
+      for (const core::Mat3& rotation : core::orientationCandidates(*n)) {
+        Result<Descriptor> fast = describer.describe(mesh, *n, rotation);
+        Result<Descriptor> slow = describeReference(mesh, *n, options, rotation);
+        ASSERT_TRUE(fast.ok() && slow.ok());
+        ASSERT_EQ(fast->cells, slow->cells)
+            << "grid " << grid << ", " << mesh.triangleCount() << " triangles";
+        for (std::size_t c = 0; c < fast->cells.size(); ++c) {
+          EXPECT_NEAR(fast->weights[c], slow->weights[c], 1e-12 * (1.0 + slow->weights[c]));
+          EXPECT_LT((fast->centroids[c] - slow->centroids[c]).cwiseAbs().maxCoeff(), 1e-9);
+        }
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GE(compared, 36);
 }
 
 // Area sampling sees the surface, not its tessellation; vertex sampling sees the vertices.

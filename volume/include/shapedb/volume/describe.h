@@ -11,8 +11,9 @@
 
 namespace shapedb::volume {
 
-/// Computes shape descriptors (paper §4) of a mesh in its canonical frame, on a sparse OpenVDB grid
-/// that accumulates, per cell, the surface area (or vertex count) and its first moment.
+/// Computes shape descriptors (paper §4) of a mesh in its canonical frame, on a dense OpenVDB grid
+/// (tools::Dense, N³ cells) that accumulates, per cell, the surface area (or vertex count) and its first
+/// moment.
 ///
 /// Area sampling clips every triangle exactly against the cells, so a cell receives exactly the part
 /// of the surface inside it: a re-tessellation of the same surface (midpoint subdivision, say) gets the
@@ -20,8 +21,9 @@ namespace shapedb::volume {
 /// face lying on a cell plane (a box's, in its canonical frame) lands on the same side whatever
 /// round-off the rigid transform left on it.
 ///
-/// One Describer per thread: it keeps its scratch (the grid's nodes, vertex buffers) between calls so
-/// that describing allocates nothing once warm. Not thread-safe; cheap to create.
+/// One Describer per thread: it keeps its scratch (the grid, vertex buffers) between calls so that
+/// describing allocates nothing once warm. Not thread-safe; cheap to create (the grid, 32·N³ bytes, is
+/// allocated by the first describe).
 class Describer {
  public:
   explicit Describer(const core::DescriptorOptions& options = {});
@@ -55,6 +57,16 @@ class Describer {
 /// One-off form of Describer::describe. Thread-safe (pure function).
 Result<core::Descriptor> describe(const core::TriangleMesh& mesh, const core::Normalization& normalization,
                                   const core::DescriptorOptions& options = {});
+
+/// The oracle of Describer::describe with area sampling: every triangle cut against each cell of its
+/// range on its own (the cell's interior planes; the border cells reach out to infinity) by the plainest
+/// polygon clipping, O(cells) per triangle, no shortcuts. The same vertices and the same side for surface
+/// on a cell plane; the same descriptor up to round-off. For tests. Errors: as describe, and
+/// kInvalidArgument for a moment descriptor or vertex sampling.
+Result<core::Descriptor> describeReference(const core::TriangleMesh& mesh,
+                                           const core::Normalization& normalization,
+                                           const core::DescriptorOptions& options,
+                                           const core::Mat3& orientation = core::Mat3::Identity());
 
 /// Checks options: grid size in [2, kMaxGridSize], minCellArea finite and in [0, 1).
 Status validateDescriptorOptions(const core::DescriptorOptions& options);
