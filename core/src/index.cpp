@@ -115,6 +115,12 @@ void packOccupancy(const std::vector<std::uint32_t>& cells, std::uint64_t* words
     words[cell / 64] |= std::uint64_t{1} << (cell % 64);
 }
 
+// The logarithms the moment term compares; a moment is positive for any solid (the floor keeps a
+// degenerate one finite).
+Vec3 logMoments(const Vec3& moments) {
+  return moments.cwiseMax(std::numeric_limits<double>::min()).array().log().matrix();
+}
+
 inline bool isGrid(DescriptorKind kind) {
   return kind != DescriptorKind::kMoment;
 }
@@ -155,6 +161,8 @@ struct Index::Query {
   CountProfile profile;
   std::vector<std::uint16_t> dense;
   Vec3 moments = Vec3::Zero();
+  Vec3 logMoments = Vec3::Zero();
+  double momentWeight = 0.0;  // voxel kinds
 };
 
 // The k best (distance, entry) pairs seen, sorted; an entry appears once, with its best candidate.
@@ -165,7 +173,7 @@ class Index::TopK {
   /// Anything whose lower bound exceeds this cannot enter.
   double threshold() const { return mItems.size() < mK ? kInfinity : mItems.back().distance; }
 
-  void push(double distance, EntryId id, int candidate) {
+  void push(double distance, EntryId id, int candidate, double momentTerm = 0.0) {
     const auto before = [](const Match& a, const Match& b) {
       return a.distance < b.distance || (a.distance == b.distance && a.entry < b.entry);
     };
@@ -180,6 +188,7 @@ class Index::TopK {
     Match m;
     m.entry = id;
     m.distance = distance;
+    m.momentTerm = momentTerm;
     m.candidate = candidate;
     if (mItems.size() == mK && !before(m, mItems.back())) return;
     mItems.insert(std::upper_bound(mItems.begin(), mItems.end(), m, before), m);
@@ -188,7 +197,7 @@ class Index::TopK {
 
   void merge(const TopK& other) {
     for (const Match& m : other.mItems)
-      push(m.distance, m.entry, m.candidate);
+      push(m.distance, m.entry, m.candidate, m.momentTerm);
   }
 
   std::vector<Match>& items() { return mItems; }
@@ -210,15 +219,17 @@ std::size_t Index::memoryBytes() const {
   return mIds.size() * sizeof(EntryId) + mCounts.size() * sizeof(std::uint32_t) +
          mBits.size() * sizeof(std::uint64_t) + mProfiles.size() * sizeof(CountProfile) +
          mCentroidBegin.size() * sizeof(std::uint64_t) + mCentroids.size() * sizeof(std::uint16_t) +
-         mBucketBegin.size() * sizeof(std::uint32_t) + mMoments.size() * sizeof(Vec3) +
+         mBucketBegin.size() * sizeof(std::uint32_t) + (mMoments.size() + mLogMoments.size()) * sizeof(Vec3) +
          mNodes.size() * sizeof(Node);
 }
 
-Index::Query Index::prepare(const Descriptor& d, int candidate) const {
+Index::Query Index::prepare(const Descriptor& d, int candidate, double momentWeight) const {
   Query q;
   q.candidate = candidate;
   q.moments = d.moments;
   if (!isGrid(mOptions.kind)) return q;
+  q.logMoments = logMoments(d.moments);
+  q.momentWeight = momentWeight;
   q.count = static_cast<std::uint32_t>(d.cells.size());
   q.bits.assign(mWords, 0);
   packOccupancy(d.cells, q.bits.data());
@@ -231,23 +242,30 @@ Index::Query Index::prepare(const Descriptor& d, int candidate) const {
   return q;
 }
 
-// Eq. (5) or (6) between the query and the entry in `slot`, on quantized centroids. Stops early, with
-// a partial value that already exceeds `threshold`, once the entry cannot be closer than it: the
-// partial sums only grow, and the same arithmetic on a larger sum never gives a smaller result.
-double Index::gridDistance(const Query& q, std::size_t slot, double threshold) const {
+// w · Σ |ln mᵢ − ln m'ᵢ| between the query and the entry in `slot`.
+double Index::momentTerm(const Query& q, std::size_t slot) const {
+  if (q.momentWeight == 0.0) return 0.0;
+  return q.momentWeight * (q.logMoments - mLogMoments[slot]).cwiseAbs().sum();
+}
+
+// Eq. (5) or (6) between the query and the entry in `slot`, on quantized centroids, plus `moments` (its
+// moment term). Stops early, with a partial value that already exceeds `threshold`, once the entry
+// cannot be closer than it: the partial sums only grow, and the same arithmetic on a larger sum never
+// gives a smaller result.
+double Index::gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const {
   const std::uint64_t* bits = &mBits[slot * mWords];
   std::uint32_t exclusive = 0;
   for (std::uint32_t w = 0; w < mWords; ++w)
     exclusive += static_cast<std::uint32_t>(std::popcount(bits[w] ^ q.bits[w]));
   const std::uint32_t total = mCounts[slot] + q.count;
-  const double mismatches = mismatchDistance(exclusive, total);
+  const double mismatches = mismatchDistance(exclusive, total) + moments;
   // Eq. (5) is the mismatches alone; for eq. (6) they may already put the entry beyond the threshold.
   if (mOptions.kind == DescriptorKind::kVoxel || total == 0 || mismatches > threshold) return mismatches;
 
   // Eq. (6): walk the cells filled in both; an entry's centroids are stored in cell order, so a
   // cell's centroid is at the rank of its bit among the entry's bits.
   const auto value = [&](std::uint64_t terms) {
-    return (static_cast<double>(exclusive) + static_cast<double>(terms) * kTermUnit) / total;
+    return (static_cast<double>(exclusive) + static_cast<double>(terms) * kTermUnit) / total + moments;
   };
   const auto& table = centroidDistanceTable();
   const std::uint16_t* centroids = &mCentroids[mCentroidBegin[slot]];
@@ -269,8 +287,9 @@ double Index::gridDistance(const Query& q, std::size_t slot, double threshold) c
 }
 
 // A lower bound of gridDistance from counts alone: the cells filled in exactly one grid number at
-// least Σ |count_a − count_b| over the parts of any partition of the grid (slabs, blocks).
-double Index::gridBound(const Query& q, std::size_t slot) const {
+// least Σ |count_a − count_b| over the parts of any partition of the grid (slabs, blocks); plus the
+// entry's moment term `moments`, the same value gridDistance adds.
+double Index::gridBound(const Query& q, std::size_t slot, double moments) const {
   const CountProfile& p = mProfiles[slot];
   const std::uint8_t* a = p.slabs.data();
   const std::uint8_t* b = q.profile.slabs.data();
@@ -279,10 +298,11 @@ double Index::gridBound(const Query& q, std::size_t slot) const {
     best =
         std::max(best, absoluteDifferenceSum<kProfileBins>(a + axis * kProfileBins, b + axis * kProfileBins));
   best = std::max(best, absoluteDifference(mCounts[slot], q.count));
-  return mismatchDistance(best, mCounts[slot] + q.count);
+  return mismatchDistance(best, mCounts[slot] + q.count) + moments;
 }
 
-// The bound for every entry with `count` filled cells: |count − n_q| cells are filled in one only.
+// The bound for every entry with `count` filled cells: |count − n_q| cells are filled in one only
+// (the moment term, ≥ 0, left out).
 double Index::countBound(const Query& q, std::uint32_t count) const {
   return mismatchDistance(absoluteDifference(count, q.count), count + q.count);
 }
@@ -312,9 +332,10 @@ void Index::searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool
     for (std::size_t slot = begin; slot < end; ++slot) {
       ++st.boundEvaluations;
       const double threshold = std::min(shared, local.threshold());
-      if (gridBound(q, slot) > threshold) continue;
+      const double moments = momentTerm(q, slot);
+      if (gridBound(q, slot, moments) > threshold) continue;
       ++st.distanceEvaluations;
-      local.push(gridDistance(q, slot, threshold), mIds[slot], q.candidate);
+      local.push(gridDistance(q, slot, threshold, moments), mIds[slot], q.candidate, moments);
     }
   };
   // The next bucket in bound order, or -1 when no bucket left can hold a match.
@@ -380,7 +401,8 @@ void Index::searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats
     for (std::size_t slot = mBucketBegin[static_cast<std::size_t>(c)];
          slot < mBucketBegin[static_cast<std::size_t>(c) + 1]; ++slot) {
       ++stats.distanceEvaluations;
-      top.push(gridDistance(q, slot, kInfinity), mIds[slot], q.candidate);
+      const double moments = momentTerm(q, slot);
+      top.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
     }
 }
 
@@ -415,6 +437,8 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
   if (candidates.empty())
     return Error{ErrorCode::kInvalidArgument, "search needs at least one query descriptor"};
   if (options.k < 1) return Error{ErrorCode::kInvalidArgument, "k must be at least 1"};
+  if (!(options.momentWeight >= 0.0 && std::isfinite(options.momentWeight)))
+    return Error{ErrorCode::kInvalidArgument, "the moment weight must be finite and at least 0"};
   for (const Descriptor& d : candidates)
     if (Status valid = validateDescriptor(d, mOptions); !valid)
       return Error{valid.error().code, "query " + valid.error().message};
@@ -424,7 +448,7 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
   std::vector<Query> queries;
   queries.reserve(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c)
-    queries.push_back(prepare(candidates[c], static_cast<int>(c)));
+    queries.push_back(prepare(candidates[c], static_cast<int>(c), options.momentWeight));
 
   TopK top(k);
   const bool grid = isGrid(mOptions.kind);
@@ -433,9 +457,12 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
     const auto scan = [&](const tbb::blocked_range<std::size_t>& range, TopK part) {
       for (std::size_t slot = range.begin(); slot != range.end(); ++slot)
         for (const Query& q : queries) {
-          const double d =
-              grid ? gridDistance(q, slot, kInfinity) : momentDistance(q.moments, mMoments[slot]);
-          part.push(d, mIds[slot], q.candidate);
+          if (!grid) {
+            part.push(momentDistance(q.moments, mMoments[slot]), mIds[slot], q.candidate);
+            continue;
+          }
+          const double moments = momentTerm(q, slot);
+          part.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
         }
       return part;
     };
@@ -477,10 +504,8 @@ Status IndexBuilder::add(EntryId id, const Descriptor& d) {
   if (Status valid = validateDescriptor(d, mOptions); !valid)
     return Error{valid.error().code, "entry " + std::to_string(id) + ": " + valid.error().message};
   mIds.push_back(id);
-  if (!isGrid(d.kind)) {
-    mMoments.push_back(d.moments);
-    return Ok{};
-  }
+  mMoments.push_back(d.moments);
+  if (!isGrid(d.kind)) return Ok{};
   mCounts.push_back(static_cast<std::uint32_t>(d.cells.size()));
   const std::size_t base = mBits.size();
   mBits.resize(base + mWords, 0);
@@ -563,10 +588,12 @@ Result<Index> IndexBuilder::build() && {
   index.mProfiles.resize(count);
   index.mCentroidBegin.assign(count + 1, 0);
   index.mCentroids.reserve(mCentroids.size());
+  index.mLogMoments.resize(count);
   for (std::size_t slot = 0; slot < count; ++slot) {
     const std::size_t i = order[slot];
     index.mIds[slot] = mIds[i];
     index.mCounts[slot] = mCounts[i];
+    index.mLogMoments[slot] = logMoments(mMoments[i]);
     std::copy_n(&mBits[i * mWords], mWords, &index.mBits[slot * mWords]);
     index.mProfiles[slot] = countProfile(&mBits[i * mWords], mOptions.gridSize);
     index.mCentroids.insert(index.mCentroids.end(),

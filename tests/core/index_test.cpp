@@ -66,7 +66,7 @@ void expectSameMatches(const std::vector<Match>& a, const std::vector<Match>& b,
 }
 
 // Pruned search against brute force: `queries` random queries against `entryCount` jittered entries,
-// with k from 1 to 10 and one to three orientation candidates per query.
+// with k from 1 to 10, one to three orientation candidates per query, and moment weights 0, 1 and 5.
 void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queries) {
   const std::vector<Descriptor> bases = baseDescriptors(kind, 150, 42);
   std::mt19937_64 rng(99);
@@ -84,6 +84,7 @@ void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queri
       candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
     SearchOptions options;
     options.k = pickK(rng);
+    options.momentWeight = q % 3 == 0 ? 0.0 : q % 3 == 1 ? 1.0 : 5.0;  // the paper's distance, ours, more
     options.method = SearchMethod::kBruteForce;
     const std::vector<Match> expected = searchOrDie(index, candidates, options, &brute);
     options.method = SearchMethod::kPruned;
@@ -151,9 +152,13 @@ TEST(Index, QuantizedDistanceStaysWithinACentroidStepOfTheExactOne) {
     const std::vector<Match> matches = searchOrDie(index, std::span(&entries[q], 1), all);
     ASSERT_EQ(matches.size(), entries.size());
     for (const Match& m : matches) {
-      const double exact = centroidVoxelDistance(entries[q], entries[(m.entry - 1000) / 7]);
+      const Descriptor& entry = entries[(m.entry - 1000) / 7];
+      const double exact = centroidVoxelDistance(entries[q], entry);
       // Each quantized coordinate moves by ≤ 1/62 cell, so each centroid term by ≤ 2 · (√3/62) / √3.
-      EXPECT_NEAR(m.distance, exact, 1.0 / 31.0 + 1e-6);
+      EXPECT_NEAR(m.distance - m.momentTerm, exact, 1.0 / 31.0 + 1e-6);
+      // The moment term, w = 1: Σ |ln mᵢ − ln m'ᵢ|.
+      const double moments = (entries[q].moments.array().log() - entry.moments.array().log()).abs().sum();
+      EXPECT_NEAR(m.momentTerm, moments, 1e-12 * (1.0 + moments));
     }
     EXPECT_EQ(matches.front().entry, 1000 + 7 * q);
     EXPECT_LT(matches.front().distance, 1.0 / 64.0);

@@ -82,6 +82,11 @@ core::Descriptor jitterDescriptor(const core::Descriptor& d, std::mt19937_64& rn
     std::sort(out.moments.data(), out.moments.data() + 3);
     return out;
   }
+  // A nearby shape is also proportioned a little differently.
+  std::normal_distribution<double> momentNoise(0.0, 0.5 * centroidNoise);
+  for (int i = 0; i < 3; ++i)
+    out.moments[i] *= std::exp(momentNoise(rng));
+  std::sort(out.moments.data(), out.moments.data() + 3);
   const int n = d.gridSize;
   std::uniform_real_distribution<double> offset(-centroidNoise, centroidNoise);
   std::vector<std::pair<std::uint32_t, core::Vec3>> cells;

@@ -31,8 +31,9 @@ struct DescribedMesh {
 };
 Result<DescribedMesh> describeMesh(const core::TriangleMesh& mesh, const core::DescriptorOptions& options);
 
-/// A copy of `d` with about `flips` cells next to the surface switched (filled ↔ empty) and every
-/// centroid moved by up to ±centroidNoise of a cell per axis: a plausible nearby shape.
+/// A copy of `d` with about `flips` cells next to the surface switched (filled ↔ empty), every centroid
+/// moved by up to ±centroidNoise of a cell per axis and the moments scaled by e^N(0, centroidNoise/2):
+/// a plausible nearby shape. Moment descriptors: the moments scaled by 1 + N(0, centroidNoise).
 core::Descriptor jitterDescriptor(const core::Descriptor& d, std::mt19937_64& rng, int flips,
                                   double centroidNoise);
 
