@@ -29,6 +29,7 @@ struct QueryCommandOptions {
   int k = 1;
   std::string descriptor = "centroid-voxel";
   std::string method = "pruned";
+  double momentWeight = core::SearchOptions{}.momentWeight;
   MaterialFlags material;
   bool json = false;
   bool timing = false;
@@ -43,7 +44,8 @@ nlohmann::json matchJson(const io::MatchReport& m) {
   nlohmann::json out = {{"entry_id", m.match.entry},
                         {"name", m.entry ? m.entry->name : ""},
                         {"family", m.entry ? volume::toString(m.entry->family) : ""},
-                        {"distance", m.match.distance}};
+                        {"distance", m.match.distance},
+                        {"moment_term", m.match.momentTerm}};
   if (m.fidelity) {
     const core::Fidelity& f = *m.fidelity;
     out["fidelity"] = {{"descriptor_distance", f.descriptorDistance},
@@ -228,6 +230,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   options.search.method = o.method == "brute-force" ? core::SearchMethod::kBruteForce
                           : o.method == "buckets"   ? core::SearchMethod::kBuckets
                                                     : core::SearchMethod::kPruned;
+  options.search.momentWeight = o.momentWeight;
   options.fidelity = !o.noFidelity;
   options.stretchCorrection = o.stretch;
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
@@ -317,11 +320,17 @@ Command addQueryCommand(CLI::App& parent) {
                   "Search: pruned (exact, fast), brute-force (the oracle), buckets (the paper's heuristic)")
       ->capture_default_str()
       ->check(CLI::IsMember({"pruned", "brute-force", "buckets"}));
+  app->add_option("--moment-weight", o->momentWeight,
+                  "Voxel descriptors: rank by the grid's distance (eq. 5 or 6) plus this weight times\n"
+                  "sum |ln(m/m')| of the principal moments, so that the match has the mesh's shape and its\n"
+                  "proportions too; 0 for the paper's distance alone")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
   addMaterialFlags(*app, o->material);
   app->add_flag(
       "--json", o->json,
       "Print one JSON object: {database, queries: [{file, matches: [{entry_id, name, family, distance,\n"
-      "fidelity}], fidelity, physics: {mass, inertia, frequencies_hz, ...}, link, timing_us}]}");
+      "moment_term, fidelity}], fidelity, physics: {mass, inertia, frequencies_hz, ...}, link, timing_us}]}");
   app->add_option("--export-obj", o->exportDir,
                   "Write <mesh>.volume.obj (the adapted tets' surface) and <mesh>.collision.obj into DIR");
   app->add_option("--png", o->png, "Draw each query beside its match (several meshes: FILE-1.png, ...)");

@@ -464,8 +464,8 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       MatchReport& m = out.matches[i];
       const core::Placement placement = core::placementOf(out.normalization, m.match.orientation);
       m.fidelity = core::assessFidelity(mesh, queryTree, out.normalization, entries[i]->locator,
-                                        entries[i]->data.massProperties, placement, m.match.distance,
-                                        options.fidelityOptions);
+                                        entries[i]->data.massProperties, placement,
+                                        m.match.distance - m.match.momentTerm, options.fidelityOptions);
     }
     out.times.fidelity = microsecondsSince(t);
   }
