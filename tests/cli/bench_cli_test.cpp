@@ -65,8 +65,13 @@ TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
   std::vector<std::vector<std::string>> rows;
   while (std::getline(csv, line))
     rows.push_back(splitCsv(line));
-  const std::vector<std::string> methods{"moment",    "voxel", "centroid-voxel",
-                                         "ellipsoid", "box",   "centroid-voxel-stretched"};
+  const std::vector<std::string> methods{"moment",
+                                         "voxel",
+                                         "centroid-voxel",
+                                         "ellipsoid",
+                                         "box",
+                                         "centroid-voxel-stretched",
+                                         "centroid-voxel-paper"};
   const std::size_t m = methods.size();
   ASSERT_GE(rows.size(), 2 * m);  // 3 seeds: at least 2 fragments, every method each
   ASSERT_EQ(rows.size() % m, 0u);

@@ -23,15 +23,30 @@
 
 namespace shapedb::io {
 
-/// What supplies a shape's physical data: the top-1 match of each descriptor, adapted (the method), or
-/// the inertia-equivalent solid ellipsoid (the precomputed sound banks of Zheng & James 2010, at their
-/// best: the exact ellipsoid rather than the nearest precomputed one) or box; and the centroid-voxel
-/// match adapted with the stretch correction (core/stretch.h; its time added to the query's).
-enum class EvaluationMethod { kMoment, kVoxel, kCentroidVoxel, kEllipsoid, kBox, kCentroidVoxelStretched };
-inline constexpr std::array<EvaluationMethod, 6> kEvaluationMethods{
-    EvaluationMethod::kMoment,    EvaluationMethod::kVoxel, EvaluationMethod::kCentroidVoxel,
-    EvaluationMethod::kEllipsoid, EvaluationMethod::kBox,   EvaluationMethod::kCentroidVoxelStretched};
-/// "moment", "voxel", "centroid-voxel", "ellipsoid", "box", "centroid-voxel-stretched".
+/// What supplies a shape's physical data: the top-1 match of each descriptor, adapted (the method; the
+/// voxel kinds ranked with their moment term, core::SearchOptions::momentWeight), or the
+/// inertia-equivalent solid ellipsoid (the precomputed sound banks of Zheng & James 2010, at their
+/// best: the exact ellipsoid rather than the nearest precomputed one) or box; the centroid-voxel match
+/// adapted with the stretch correction (core/stretch.h; its time added to the query's); and the
+/// centroid-voxel match by the paper's distance alone (eq. 6, no moment term).
+enum class EvaluationMethod {
+  kMoment,
+  kVoxel,
+  kCentroidVoxel,
+  kEllipsoid,
+  kBox,
+  kCentroidVoxelStretched,
+  kCentroidVoxelPaper
+};
+inline constexpr std::array<EvaluationMethod, 7> kEvaluationMethods{EvaluationMethod::kMoment,
+                                                                    EvaluationMethod::kVoxel,
+                                                                    EvaluationMethod::kCentroidVoxel,
+                                                                    EvaluationMethod::kEllipsoid,
+                                                                    EvaluationMethod::kBox,
+                                                                    EvaluationMethod::kCentroidVoxelStretched,
+                                                                    EvaluationMethod::kCentroidVoxelPaper};
+/// "moment", "voxel", "centroid-voxel", "ellipsoid", "box", "centroid-voxel-stretched",
+/// "centroid-voxel-paper".
 const char* toString(EvaluationMethod method);
 
 struct MethodEvaluation {
@@ -39,7 +54,7 @@ struct MethodEvaluation {
   EvaluationMethod method = EvaluationMethod::kCentroidVoxel;
   std::string match;              ///< the matched entry's name (descriptors); "" for the baselines
   std::string family;             ///< the matched entry's family (descriptors); "" for the baselines
-  double distance = kNaN;         ///< descriptor distance (descriptors)
+  double distance = kNaN;         ///< the search's distance (descriptors: Match::distance)
   Eigen::VectorXd frequenciesHz;  ///< the first non-rigid frequencies, in the material
   /// Relative frequency errors against the direct computation, (f − f*) / f*: the first (signed), the
   /// mean and the max of |·| over the first EvaluationOptions::frequencies.
