@@ -1,3 +1,4 @@
+#include <array>
 #include <cmath>
 #include <complex>
 #include <utility>
@@ -5,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <shapedb/core/chunks.h>
 #include <shapedb/core/normalize.h>
 
 namespace shapedb::core {
@@ -17,28 +19,42 @@ namespace {
 std::array<double, 2> thirdMomentsExact(const TriangleMesh& mesh, const Vec3& c, const Vec3& ux,
                                         const Vec3& uy) {
   // Every vertex once in the frame (ux, uy, ux × uy) about c; determinants do not depend on the frame.
+  // Large meshes in core::Chunks, in parallel (the sums do not depend on the threads).
   thread_local std::vector<Vec3> local;
   local.resize(mesh.vertices.size());
   Mat3 frameFromMesh;
   frameFromMesh.row(0) = ux;
   frameFromMesh.row(1) = uy;
   frameFromMesh.row(2) = ux.cross(uy);
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-    local[i] = frameFromMesh * (mesh.vertices[i] - c);
+  Vec3* q = local.data();
+  Chunks(mesh.vertices.size()).run([&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      q[i] = frameFromMesh * (mesh.vertices[i] - c);
+  });
   const auto sixH3 = [](double w1, double w2, double w3) {
     const double p1 = w1 + w2 + w3, p2 = w1 * w1 + w2 * w2 + w3 * w3,
                  p3 = w1 * w1 * w1 + w2 * w2 * w2 + w3 * w3 * w3;
     return p1 * p1 * p1 + 3.0 * p1 * p2 + 2.0 * p3;
   };
-  double sumX = 0.0, sumY = 0.0;
-  const Vec3* q = local.data();
-  for (const auto& t : mesh.triangles) {
-    const Vec3& a = q[t[0]];
-    const Vec3& b = q[t[1]];
-    const Vec3& d = q[t[2]];
-    const double det = a.dot(b.cross(d));
-    sumX += det * sixH3(a.x(), b.x(), d.x());
-    sumY += det * sixH3(a.y(), b.y(), d.y());
+  const Chunks chunks(mesh.triangles.size());
+  std::array<std::array<double, 2>, Chunks::kMaxChunks> parts{};
+  chunks.run([&](std::size_t chunk, std::size_t begin, std::size_t end) {
+    double sumX = 0.0, sumY = 0.0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto& t = mesh.triangles[i];
+      const Vec3& a = q[t[0]];
+      const Vec3& b = q[t[1]];
+      const Vec3& d = q[t[2]];
+      const double det = a.dot(b.cross(d));
+      sumX += det * sixH3(a.x(), b.x(), d.x());
+      sumY += det * sixH3(a.y(), b.y(), d.y());
+    }
+    parts[chunk] = {sumX, sumY};
+  });
+  double sumX = parts[0][0], sumY = parts[0][1];
+  for (std::size_t chunk = 1; chunk < chunks.count; ++chunk) {
+    sumX += parts[chunk][0];
+    sumY += parts[chunk][1];
   }
   // det/6 is the tet volume, so V/20 · h₃ = det/720 · 6 h₃.
   return {sumX / 720.0, sumY / 720.0};

@@ -3,6 +3,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/primitives.h>
@@ -97,6 +98,38 @@ TEST(MassProperties, RotatedTranslatedBoxMatchesClosedForm) {
     EXPECT_LT(relativeError(mp.inertia, r * local * r.transpose()), 1e-9);
     EXPECT_LT(relativeError(mp.area, 2 * (a * b + b * c + a * c)), 1e-12);
   }
+}
+
+// A large mesh is integrated in chunks in parallel: still exact (a box subdivided to 12,288 triangles is
+// the box), and the same to the bit on one thread as on many.
+TEST(MassProperties, ChunkedIntegralsOfALargeMeshAreExactAndThreadIndependent) {
+  std::mt19937_64 rng(8);
+  const double a = 1.3, b = 0.4, c = 2.9;
+  TriangleMesh box = makeBox({a, b, c});
+  for (int i = 0; i < 5; ++i)
+    box = subdivideMidpoint(box);
+  ASSERT_EQ(box.triangleCount(), 12288u);
+  Mat4 t = Mat4::Identity();
+  const Mat3 r = test::randomRotation(rng);
+  t.topLeftCorner<3, 3>() = r;
+  t.topRightCorner<3, 1>() = Vec3(3.0, -4.0, 5.0);
+  const TriangleMesh mesh = transformed(box, t);
+  const MassProperties many = mustCompute(mesh);
+  const Mat3 local = Vec3(a * b * c * (b * b + c * c) / 12, a * b * c * (a * a + c * c) / 12,
+                          a * b * c * (a * a + b * b) / 12)
+                         .asDiagonal();
+  EXPECT_LT(relativeError(many.volume, a * b * c), 1e-12);
+  EXPECT_LT((many.centerOfMass - t.topRightCorner<3, 1>()).norm(), 1e-12);
+  EXPECT_LT(relativeError(many.inertia, r * local * r.transpose()), 1e-12);
+  MassProperties one;
+  {
+    const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
+    one = mustCompute(mesh);
+  }
+  EXPECT_EQ(one.volume, many.volume);
+  EXPECT_EQ(one.centerOfMass, many.centerOfMass);
+  EXPECT_EQ(one.inertia, many.inertia);
+  EXPECT_EQ(one.area, many.area);
 }
 
 TEST(MassProperties, FarFromTheOriginKeepsItsPrecision) {

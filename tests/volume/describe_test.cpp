@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <shapedb/core/index.h>
 #include <shapedb/core/mass_properties.h>
@@ -255,6 +256,23 @@ TEST(Describe, AreaSamplingAgreesWithClippingEveryCellOnItsOwn) {
     }
   }
   EXPECT_GE(compared, 36);
+}
+
+// Large meshes are binned in chunks in parallel; the chunks depend on the triangle count only, so the
+// descriptor is the same to the bit on one thread as on many.
+TEST(Describe, ChunkedAreaSamplingIsTheSameOnOneThreadAndMany) {
+  const TriangleMesh mesh =
+      core::subdivideMidpoint(test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 4));  // 20,480
+  const DescriptorOptions options = test::descriptorOptions(DescriptorKind::kCentroidVoxel, Sampling::kArea);
+  const Descriptor many = describeOrDie(mesh, options);
+  Descriptor one;
+  {
+    const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
+    one = describeOrDie(mesh, options);
+  }
+  EXPECT_EQ(one.cells, many.cells);
+  EXPECT_EQ(one.centroids, many.centroids);
+  EXPECT_EQ(one.weights, many.weights);
 }
 
 // Area sampling sees the surface, not its tessellation; vertex sampling sees the vertices.

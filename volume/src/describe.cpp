@@ -10,6 +10,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
+#include <shapedb/core/chunks.h>
 #include <shapedb/volume/describe.h>
 #include <shapedb/volume/openvdb_runtime.h>
 
@@ -203,64 +204,83 @@ core::Descriptor finishDescriptor(const core::DescriptorOptions& options,
   return out;
 }
 
-}  // namespace
-
-struct Describer::Impl {
-  SnappedVertices grid;
-  // N³ sums, all zero between calls, and a bit per cell written in this call: read out in linear order
-  // without a sort, and the only cells cleared for the next call.
-  std::unique_ptr<DenseGrid> dense;
-  double* sums = nullptr;  // dense's values as (weight, Σ weight·x, Σ weight·y, Σ weight·z) per cell
-  std::vector<std::uint64_t> written;
-  std::vector<std::pair<std::uint32_t, Accumulator>> filled;
-
-  void prepareGrid(int n) {
-    if (!dense || dense->bbox().dim().x() != n) {
-      dense = std::make_unique<DenseGrid>(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(n - 1)),
-                                          Accumulator(0.0));
-      written.assign((dense->valueCount() + 63) / 64, 0);
+// Per-cell sums of weight and first moment on an N³ grid, all zero between uses, with a bit per cell
+// written: read out in linear order without a sort, and only the cells written cleared.
+class CellSums {
+ public:
+  void prepare(int n) {
+    if (!mDense || mDense->bbox().dim().x() != n) {
+      mDense = std::make_unique<DenseGrid>(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(n - 1)),
+                                           Accumulator(0.0));
+      mWritten.assign((mDense->valueCount() + 63) / 64, 0);
     }
     static_assert(sizeof(Accumulator) == 4 * sizeof(double));
-    sums = reinterpret_cast<double*>(dense->data());
+    mSums = reinterpret_cast<double*>(mDense->data());
+    mGridSize = n;
+  }
+
+  void add(const Cell& cell, double weight, const Vec3& weightedPosition) {
+    const std::uint32_t index = core::linearCell(cell[0], cell[1], cell[2], mGridSize);
+    if (index != mPendingCell) {
+      flush();
+      mPendingCell = index;
+    }
+    mPending += Eigen::Vector4d(weight, weightedPosition.x(), weightedPosition.y(), weightedPosition.z());
+  }
+
+  void flush() {
+    if (mPendingCell == kNoCell) return;
+    write(mPendingCell, mPending);
+    mPendingCell = kNoCell;
+    mPending.setZero();
+  }
+
+  // Calls f(cell, sums) for every written cell in linear order, and clears it.
+  template <typename F>
+  void drain(F&& f) {
+    flush();
+    for (std::size_t w = 0; w < mWritten.size(); ++w) {
+      for (std::uint64_t bits = mWritten[w]; bits != 0; bits &= bits - 1) {
+        const auto index =
+            static_cast<std::uint32_t>(64 * w + static_cast<std::size_t>(std::countr_zero(bits)));
+        double* sum = mSums + 4 * std::size_t{index};
+        f(index, Eigen::Vector4d(sum[0], sum[1], sum[2], sum[3]));
+        std::fill(sum, sum + 4, 0.0);
+      }
+      mWritten[w] = 0;
+    }
+  }
+
+  // Adds `other`'s sums into these, cell by cell, and clears `other`.
+  void absorb(CellSums& other) {
+    flush();
+    other.drain([&](std::uint32_t cell, const Eigen::Vector4d& sum) { write(cell, sum); });
+  }
+
+ private:
+  void write(std::uint32_t cell, const Eigen::Vector4d& sum) {
+    Eigen::Map<Eigen::Vector4d>(mSums + 4 * std::size_t{cell}) += sum;
+    mWritten[cell / 64] |= std::uint64_t{1} << (cell % 64);
   }
 
   // Consecutive pieces mostly land in the same cell: their sum is kept apart and written to the grid
   // (and its bit set) when the cell changes.
   static constexpr std::uint32_t kNoCell = std::numeric_limits<std::uint32_t>::max();
-  std::uint32_t pendingCell = kNoCell;
-  Eigen::Vector4d pending = Eigen::Vector4d::Zero();
+  std::uint32_t mPendingCell = kNoCell;
+  Eigen::Vector4d mPending = Eigen::Vector4d::Zero();
+  std::unique_ptr<DenseGrid> mDense;
+  double* mSums = nullptr;  // mDense's values as (weight, Σ weight·x, Σ weight·y, Σ weight·z) per cell
+  std::vector<std::uint64_t> mWritten;
+  int mGridSize = 0;
+};
+
+// Bins the surface of triangles into one CellSums, exactly.
+struct Binner {
+  const SnappedVertices& grid;
+  CellSums& sums;
 
   void add(const Cell& cell, double weight, const Vec3& weightedPosition) {
-    const std::uint32_t index = core::linearCell(cell[0], cell[1], cell[2], grid.gridSize);
-    if (index != pendingCell) {
-      flush();
-      pendingCell = index;
-    }
-    pending += Eigen::Vector4d(weight, weightedPosition.x(), weightedPosition.y(), weightedPosition.z());
-  }
-
-  void flush() {
-    if (pendingCell == kNoCell) return;
-    Eigen::Map<Eigen::Vector4d>(sums + 4 * std::size_t{pendingCell}) += pending;
-    written[pendingCell / 64] |= std::uint64_t{1} << (pendingCell % 64);
-    pendingCell = kNoCell;
-    pending.setZero();
-  }
-
-  // The written cells in linear order, each sum then cleared.
-  void readOut() {
-    flush();
-    filled.clear();
-    for (std::size_t w = 0; w < written.size(); ++w) {
-      for (std::uint64_t bits = written[w]; bits != 0; bits &= bits - 1) {
-        const auto index =
-            static_cast<std::uint32_t>(64 * w + static_cast<std::size_t>(std::countr_zero(bits)));
-        double* sum = sums + 4 * std::size_t{index};
-        filled.emplace_back(index, Accumulator(sum[0], sum[1], sum[2], sum[3]));
-        std::fill(sum, sum + 4, 0.0);
-      }
-      written[w] = 0;
-    }
+    sums.add(cell, weight, weightedPosition);
   }
 
   int cellOf(double u, double normal) const { return volume::cellOf(u, normal, grid.gridSize); }
@@ -437,6 +457,19 @@ struct Describer::Impl {
   }
 };
 
+// Area sampling of large meshes runs in core::Chunks of triangles, in parallel, each into its own sums,
+// added in chunk order: the descriptor does not depend on the threads. Grids up to this many cells a
+// side only (each chunk's sums are N³).
+constexpr int kMaxChunkedGrid = 32;
+
+}  // namespace
+
+struct Describer::Impl {
+  SnappedVertices grid;
+  std::vector<CellSums> chunks;  // chunks[0] holds the result
+  std::vector<std::pair<std::uint32_t, Accumulator>> filled;
+};
+
 Describer::Describer(const core::DescriptorOptions& options)
     : mOptions(options), mImpl(std::make_unique<Impl>()) {
   initializeOpenVdb();
@@ -468,19 +501,37 @@ Result<core::Descriptor> Describer::describe(const core::TriangleMesh& mesh,
     return out;
   }
   Impl& s = *mImpl;
-  if (Status ok = s.grid.prepare(mesh, normalization, orientation, mOptions.gridSize); !ok) return ok.error();
-  s.prepareGrid(mOptions.gridSize);
+  const int n = mOptions.gridSize;
+  if (Status ok = s.grid.prepare(mesh, normalization, orientation, n); !ok) return ok.error();
 
   // Accumulate weight and first moment per cell.
+  const core::Chunks chunks = mOptions.sampling == Sampling::kArea && n <= kMaxChunkedGrid
+                                  ? core::Chunks(mesh.triangles.size())
+                                  : core::Chunks(0);
+  if (s.chunks.size() < chunks.count) s.chunks.resize(chunks.count);
+  for (std::size_t c = 0; c < chunks.count; ++c)
+    s.chunks[c].prepare(n);
   if (mOptions.sampling == Sampling::kVertices) {
     for (std::size_t i = 0; i < s.grid.coords.size(); ++i)
-      s.add(s.grid.cells[i], 1.0, s.grid.coords[i]);
-  } else {
+      s.chunks[0].add(s.grid.cells[i], 1.0, s.grid.coords[i]);
+  } else if (chunks.count == 1) {
+    Binner binner{s.grid, s.chunks[0]};
     for (const auto& t : mesh.triangles)
-      s.addTriangle(t[0], t[1], t[2]);
+      binner.addTriangle(t[0], t[1], t[2]);
+  } else {
+    chunks.run([&](std::size_t c, std::size_t begin, std::size_t end) {
+      Binner binner{s.grid, s.chunks[c]};
+      for (std::size_t t = begin; t < end; ++t)
+        binner.addTriangle(mesh.triangles[t][0], mesh.triangles[t][1], mesh.triangles[t][2]);
+    });
+    for (std::size_t c = 1; c < chunks.count; ++c)
+      s.chunks[0].absorb(s.chunks[c]);
   }
 
-  s.readOut();
+  s.filled.clear();
+  s.chunks[0].drain([&](std::uint32_t cell, const Eigen::Vector4d& sum) {
+    s.filled.emplace_back(cell, Accumulator(sum[0], sum[1], sum[2], sum[3]));
+  });
   return finishDescriptor(mOptions, normalization, orientation, s.grid, s.filled);
 }
 

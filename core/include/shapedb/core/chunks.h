@@ -1,0 +1,37 @@
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+
+#include <tbb/parallel_for.h>
+
+namespace shapedb::core {
+
+/// A fixed split of n items into consecutive chunks for a parallel sum that does not depend on the
+/// threads: the chunks depend on n alone (one per kSize items, at most kMaxChunks, at least one), each
+/// chunk is summed in item order, and the chunks' sums are added in chunk order. So a large mesh's
+/// integrals or descriptor are the same to the bit on one thread as on many (and a mesh under
+/// 2 × kSize items is summed exactly as a plain loop would).
+struct Chunks {
+  static constexpr std::size_t kSize = 2048, kMaxChunks = 8;
+  std::size_t items = 0;
+  std::size_t count = 1;  ///< 1 to kMaxChunks
+
+  explicit Chunks(std::size_t n) : items(n), count(std::clamp<std::size_t>(n / kSize, 1, kMaxChunks)) {}
+  std::size_t begin(std::size_t chunk) const { return chunk * (items / count); }
+  std::size_t end(std::size_t chunk) const {
+    return chunk + 1 == count ? items : (chunk + 1) * (items / count);
+  }
+
+  /// Runs f(chunk, begin, end) for every chunk, in parallel when there are several.
+  template <typename F>
+  void run(F&& f) const {
+    if (count == 1) {
+      f(std::size_t{0}, std::size_t{0}, items);
+      return;
+    }
+    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t c) { f(c, begin(c), end(c)); });
+  }
+};
+
+}  // namespace shapedb::core
