@@ -1,4 +1,3 @@
-#include <array>
 #include <cmath>
 #include <string>
 
@@ -27,7 +26,7 @@ struct FanSums {
   double fx = 0.0, fy = 0.0, fz = 0.0;
   double xx = 0.0, yy = 0.0, zz = 0.0, xy = 0.0, yz = 0.0, zx = 0.0;
 
-  void add(const FanSums& o) {
+  FanSums& operator+=(const FanSums& o) {
     det += o.det;
     absDet += o.absDet;
     twiceArea += o.twiceArea;
@@ -40,6 +39,7 @@ struct FanSums {
     xy += o.xy;
     yz += o.yz;
     zx += o.zx;
+    return *this;
   }
 };
 
@@ -69,14 +69,9 @@ FanSums fanSums(const TriangleMesh& mesh, const Vec3& reference, std::size_t beg
 }
 
 VolumeIntegrals integrateFan(const TriangleMesh& mesh, const Vec3& reference) {
-  const Chunks chunks(mesh.triangles.size());
-  std::array<FanSums, Chunks::kMaxChunks> parts;
-  chunks.run([&](std::size_t c, std::size_t begin, std::size_t end) {
-    parts[c] = fanSums(mesh, reference, begin, end);
+  const FanSums f = Chunks(mesh.triangles.size()).sum<FanSums>([&](std::size_t begin, std::size_t end) {
+    return fanSums(mesh, reference, begin, end);
   });
-  FanSums f = parts[0];
-  for (std::size_t c = 1; c < chunks.count; ++c)
-    f.add(parts[c]);
   VolumeIntegrals out;
   out.volume = f.det / 6.0;
   out.absoluteVolume = f.absDet / 6.0;

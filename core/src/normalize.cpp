@@ -36,28 +36,22 @@ std::array<double, 2> thirdMomentsExact(const TriangleMesh& mesh, const Vec3& c,
                  p3 = w1 * w1 * w1 + w2 * w2 * w2 + w3 * w3 * w3;
     return p1 * p1 * p1 + 3.0 * p1 * p2 + 2.0 * p3;
   };
-  const Chunks chunks(mesh.triangles.size());
-  std::array<std::array<double, 2>, Chunks::kMaxChunks> parts{};
-  chunks.run([&](std::size_t chunk, std::size_t begin, std::size_t end) {
-    double sumX = 0.0, sumY = 0.0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const auto& t = mesh.triangles[i];
-      const Vec3& a = q[t[0]];
-      const Vec3& b = q[t[1]];
-      const Vec3& d = q[t[2]];
-      const double det = a.dot(b.cross(d));
-      sumX += det * sixH3(a.x(), b.x(), d.x());
-      sumY += det * sixH3(a.y(), b.y(), d.y());
-    }
-    parts[chunk] = {sumX, sumY};
-  });
-  double sumX = parts[0][0], sumY = parts[0][1];
-  for (std::size_t chunk = 1; chunk < chunks.count; ++chunk) {
-    sumX += parts[chunk][0];
-    sumY += parts[chunk][1];
-  }
+  const Eigen::Vector2d sums =
+      Chunks(mesh.triangles.size()).sum<Eigen::Vector2d>([&](std::size_t begin, std::size_t end) {
+        double sumX = 0.0, sumY = 0.0;
+        for (std::size_t i = begin; i < end; ++i) {
+          const auto& t = mesh.triangles[i];
+          const Vec3& a = q[t[0]];
+          const Vec3& b = q[t[1]];
+          const Vec3& d = q[t[2]];
+          const double det = a.dot(b.cross(d));
+          sumX += det * sixH3(a.x(), b.x(), d.x());
+          sumY += det * sixH3(a.y(), b.y(), d.y());
+        }
+        return Eigen::Vector2d(sumX, sumY);
+      });
   // det/6 is the tet volume, so V/20 · h₃ = det/720 · 6 h₃.
-  return {sumX / 720.0, sumY / 720.0};
+  return {sums.x() / 720.0, sums.y() / 720.0};
 }
 
 // The same moments for the approximate properties: the vertex point masses, scaled to a volume

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 
 #include <tbb/parallel_for.h>
@@ -31,6 +32,18 @@ struct Chunks {
       return;
     }
     tbb::parallel_for(std::size_t{0}, count, [&](std::size_t c) { f(c, begin(c), end(c)); });
+  }
+
+  /// The sum over the chunks of partial(begin, end), each computed as run() does and added in chunk
+  /// order. T: copyable, with +=.
+  template <typename T, typename F>
+  T sum(F&& partial) const {
+    std::array<T, kMaxChunks> parts{};
+    run([&](std::size_t c, std::size_t first, std::size_t last) { parts[c] = partial(first, last); });
+    T total = parts[0];
+    for (std::size_t c = 1; c < count; ++c)
+      total += parts[c];
+    return total;
   }
 };
 
