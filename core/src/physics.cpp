@@ -15,17 +15,21 @@ double tetVolume(const TetMesh& mesh, std::size_t t) {
   return (mesh.nodes[b] - pa).cross(mesh.nodes[c] - pa).dot(mesh.nodes[d] - pa) / 6.0;
 }
 
-Status validateTetMesh(const TetMesh& mesh) {
-  if (mesh.nodes.empty() || mesh.tets.empty()) return Error{ErrorCode::kEmptyMesh, "tet mesh has no tets"};
+double flatTetVolume(const TetMesh& mesh) {
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Vec3& p : mesh.nodes) {
-    if (!p.allFinite()) return Error{ErrorCode::kNonFinite, "tet mesh has a non-finite node"};
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
+  return 1e-15 * std::pow((hi - lo).maxCoeff(), 3);
+}
+
+Status validateTetMesh(const TetMesh& mesh) {
+  if (mesh.nodes.empty() || mesh.tets.empty()) return Error{ErrorCode::kEmptyMesh, "tet mesh has no tets"};
+  for (const Vec3& p : mesh.nodes)
+    if (!p.allFinite()) return Error{ErrorCode::kNonFinite, "tet mesh has a non-finite node"};
   const std::size_t n = mesh.nodes.size();
-  // A tet far smaller than the mesh's scale is numerically flat: its stiffness would be garbage.
-  const double minVolume = 1e-15 * std::pow((hi - lo).maxCoeff(), 3);
+  const double minVolume = flatTetVolume(mesh);
   for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
     for (std::uint32_t v : mesh.tets[t])
       if (v >= n)

@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
-#include <limits>
 #include <poll.h>
 #include <signal.h>
 #include <string>
@@ -390,16 +389,11 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
 // 1e-18 of the volume between them, which TetGen fills with flat tets; their stiffness would be garbage,
 // and their volume is below the fill check's tolerance by nine orders of magnitude.
 void dropFlatTets(TetMesh& mesh) {
-  core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const core::Vec3& p : mesh.nodes) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const double minVolume = 1e-15 * std::pow((hi - lo).maxCoeff(), 3);
-  std::erase_if(mesh.tets, [&](const TetMesh::Tet& t) {
-    const core::Vec3& a = mesh.nodes[t[0]];
-    return !((mesh.nodes[t[1]] - a).cross(mesh.nodes[t[2]] - a).dot(mesh.nodes[t[3]] - a) / 6.0 > minVolume);
-  });
+  const double minVolume = core::flatTetVolume(mesh);
+  std::size_t keptTets = 0;
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t)
+    if (core::tetVolume(mesh, t) > minVolume) mesh.tets[keptTets++] = mesh.tets[t];
+  mesh.tets.resize(keptTets);
   std::vector<std::int64_t> renumber(mesh.nodes.size(), -1);
   for (const TetMesh::Tet& t : mesh.tets)
     for (std::uint32_t v : t)

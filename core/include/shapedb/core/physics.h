@@ -40,7 +40,11 @@ TetGradients tetGradients(const TetMesh& mesh, std::size_t t);
 /// The same for a tet given by its four corners.
 TetGradients tetGradients(const std::array<Vec3, 4>& corners);
 
-/// Checks indices, finiteness and that every tet has positive volume (relative to the mesh's scale).
+/// The volume at or under which a tet of `mesh` is numerically flat, its stiffness garbage: 1e-15 of the
+/// cube of the nodes' largest extent.
+double flatTetVolume(const TetMesh& mesh);
+
+/// Checks indices, finiteness and that every tet has a volume above flatTetVolume.
 /// Errors: kEmptyMesh, kIndexOutOfRange, kNonFinite, kDegenerateFace (a flat or inverted tet).
 Status validateTetMesh(const TetMesh& mesh);
 

@@ -45,8 +45,8 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, 
 Result<core::TetMesh> tetrahedralize(const core::TriangleMesh& surface,
                                      const TetrahedralizeOptions& options = {});
 
-/// Removes the tets with no volume to speak of (under validateTetMesh's flatness bound, 1e-15 of the
-/// mesh's extent cubed) and the nodes left without a tet. tetrahedralize does it to TetGen's output; a
+/// Removes the tets with no volume to speak of (at or under core::flatTetVolume, which validateTetMesh
+/// refuses) and the nodes left without a tet. tetrahedralize does it to TetGen's output; a
 /// mesh moved to another frame needs it again, since round-off can flatten a tet that was just above
 /// the bound.
 void dropFlatTets(core::TetMesh& mesh);
