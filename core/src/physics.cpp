@@ -1,9 +1,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <numbers>
 #include <string>
+#include <tuple>
 
 #include <shapedb/core/physics.h>
 
@@ -95,21 +95,34 @@ MassProperties computeTetMassProperties(const TetMesh& mesh, double density) {
 
 std::vector<BoundaryFace> boundaryFaces(const TetMesh& mesh) {
   // A face seen by one tet only is on the boundary. Faces of a positively oriented tet (a, b, c, d),
-  // wound outward: (a, c, b), (a, b, d), (b, c, d), (a, d, c).
-  std::map<std::array<std::uint32_t, 3>, std::pair<BoundaryFace, int>> faces;
+  // wound outward: (a, c, b), (a, b, d), (b, c, d), (a, d, c). All faces sorted by their sorted node
+  // triple (ties by tet and face, so the order is fixed): an inner face is two equal keys in a row.
+  struct Keyed {
+    std::array<std::uint32_t, 3> key;
+    BoundaryFace face;
+  };
+  std::vector<Keyed> faces;
+  faces.reserve(4 * mesh.tets.size());
   for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
     const auto& [a, b, c, d] = mesh.tets[t];
     for (const std::array<std::uint32_t, 3>& f :
          {std::array{a, c, b}, std::array{a, b, d}, std::array{b, c, d}, std::array{a, d, c}}) {
       std::array<std::uint32_t, 3> key = f;
       std::sort(key.begin(), key.end());
-      auto [it, inserted] = faces.try_emplace(key, BoundaryFace{f, t}, 0);
-      ++it->second.second;
+      faces.push_back({key, BoundaryFace{f, t}});
     }
   }
+  std::sort(faces.begin(), faces.end(), [](const Keyed& x, const Keyed& y) {
+    return std::tie(x.key, x.face.tet) < std::tie(y.key, y.face.tet);
+  });
   std::vector<BoundaryFace> out;
-  for (const auto& [key, face] : faces)
-    if (face.second == 1) out.push_back(face.first);
+  for (std::size_t i = 0; i < faces.size();) {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key)
+      ++j;
+    if (j == i + 1) out.push_back(faces[i].face);
+    i = j;
+  }
   return out;
 }
 

@@ -24,8 +24,9 @@ Solid solidOrDie(const core::TriangleMesh& surface, const TetrahedralizeOptions&
   Result<TetMesh> tets = tetrahedralize(surface, tetgen);
   EXPECT_TRUE(tets.ok()) << (tets ? "" : tets.error().message);
   if (!tets) return {};
-  ModalOptions options;
+  ModalOptions options;  // the stretch basis is that of linear tets
   options.modes = modes;
+  options.order = ElementOrder::kLinear;
   Result<core::ModalData> m = computeModes(*tets, options);
   EXPECT_TRUE(m.ok()) << (m ? "" : m.error().message);
   if (!m) return {};
@@ -129,6 +130,7 @@ TEST(Stretch, StretchedPlateHasTheFrequenciesOfTheWiderThinnerPlate) {
   ASSERT_EQ(entry.modes.modeCount(), 20u);
   ModalOptions options;
   options.modes = 6;
+  options.order = ElementOrder::kLinear;
   Result<core::ModalData> truth = computeModes(stretched(entry.mesh, a), options);
   ASSERT_TRUE(truth.ok()) << truth.error().message;
   auto fast =

@@ -23,16 +23,23 @@ class Stopwatch {
 
 }  // namespace
 
+TetrahedralizeOptions entryMeshing(ElementOrder order) {
+  TetrahedralizeOptions options;
+  if (order == ElementOrder::kQuadratic) {
+    options.maxRadiusEdgeRatio = 3.0;
+    options.maxVolumeFraction = 1.0 / 100.0;
+  } else {
+    options.maxRadiusEdgeRatio = 1.5;
+    options.maxVolumeFraction = 1.0 / 600.0;
+  }
+  return options;
+}
+
 EntryOptions withElements(EntryOptions options, ElementOrder order) {
   options.modal.order = order;
-  const TetrahedralizeOptions defaults;
-  if (order == ElementOrder::kQuadratic) {
-    options.tetgen.maxRadiusEdgeRatio = 3.0;
-    options.tetgen.maxVolumeFraction = 1.0 / 100.0;
-  } else {
-    options.tetgen.maxRadiusEdgeRatio = defaults.maxRadiusEdgeRatio;
-    options.tetgen.maxVolumeFraction = defaults.maxVolumeFraction;
-  }
+  const TetrahedralizeOptions bounds = entryMeshing(order);
+  options.tetgen.maxRadiusEdgeRatio = bounds.maxRadiusEdgeRatio;
+  options.tetgen.maxVolumeFraction = bounds.maxVolumeFraction;
   return options;
 }
 

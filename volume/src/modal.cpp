@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
@@ -18,6 +19,31 @@ namespace {
 using core::ModalData;
 using core::TetMesh;
 using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// A fill-reducing ordering for matrices of 3 × 3 blocks (a node's x, y, z): approximate minimum degree
+/// on the graph of the nodes, each node's three rows kept together. The same fill as AMD on the scalar
+/// graph here, in half the analysis time (the node graph has a ninth of the entries).
+struct NodeBlockAmdOrdering {
+  using PermutationType = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
+  template <typename MatrixType>
+  void operator()(const MatrixType& matrix, PermutationType& permutation) {
+    const Eigen::Index nodes = matrix.rows() / 3;
+    std::vector<Eigen::Triplet<double, int>> pattern;
+    pattern.reserve(static_cast<std::size_t>(matrix.nonZeros() / 9 + nodes));
+    for (Eigen::Index column = 0; column < matrix.outerSize(); column += 3)
+      for (typename MatrixType::InnerIterator it(matrix, column); it; ++it)
+        if (it.row() % 3 == 0)
+          pattern.emplace_back(static_cast<int>(it.row() / 3), static_cast<int>(column / 3), 1.0);
+    Eigen::SparseMatrix<double, Eigen::ColMajor, int> graph(nodes, nodes);
+    graph.setFromTriplets(pattern.begin(), pattern.end());
+    PermutationType nodeOrder;
+    Eigen::AMDOrdering<int>()(graph, nodeOrder);
+    permutation.resize(3 * nodes);
+    for (Eigen::Index i = 0; i < nodes; ++i)
+      for (int c = 0; c < 3; ++c)
+        permutation.indices()[3 * i + c] = 3 * nodeOrder.indices()[i] + c;
+  }
+};
 
 /// y = P (K − σM)⁻¹ x for Spectra's shift-invert mode, by a sparse LDLᵀ of K − σM (symmetric positive
 /// definite for σ < 0: K is semi-definite and M definite; Spectra's own SymShiftInvert uses sparse LU,
@@ -48,7 +74,7 @@ class ShiftInvertLdlt {
   const SparseMatrix& mM;
   const Eigen::MatrixXd& mRigid;
   const Eigen::MatrixXd mMRigid;
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> mSolver;
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, NodeBlockAmdOrdering> mSolver;
   bool mOk = false;
 };
 
@@ -85,7 +111,7 @@ Status checkOptions(std::size_t nodeCount, const ModalOptions& options) {
   if (!(m.youngsModulus > 0.0 && m.density > 0.0 && std::isfinite(m.youngsModulus) &&
         std::isfinite(m.density)))
     return Error{ErrorCode::kInvalidArgument, "Young's modulus and density must be finite and positive"};
-  if (!(m.poissonRatio >= 0.0 && m.poissonRatio < 0.5))
+  if (!validPoissonRatio(m.poissonRatio))
     return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in [0, 0.5)"};
   if (3 * nodeCount < static_cast<std::size_t>(options.modes) + 6 + 2)
     return Error{ErrorCode::kInvalidArgument,
@@ -401,9 +427,11 @@ FemMatrices assembleFem(const QuadraticTetMesh& mesh, const FemMaterial& materia
 
 namespace {
 
-/// Shift-invert Lanczos on assembled matrices (computeModes of either order).
+/// Shift-invert Lanczos on assembled matrices (computeModes of either order), from `start` when given
+/// (else Spectra's own random vector); `solves` counts the solves with the factorized K − σM.
 Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMatrices& fem,
-                              const ModalOptions& options) {
+                              const ModalOptions& options, const Eigen::VectorXd* start = nullptr,
+                              int* solves = nullptr) {
   const auto n = fem.stiffness.rows();
   // The rigid modes are known in closed form: detect them (K r ≈ 0, Rayleigh quotients near zero) and
   // deflate them, so that Lanczos looks for the elastic modes only.
@@ -426,11 +454,35 @@ Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMat
       eigs(op, bop, nev, ncv, sigma);
   if (!op.ok())
     return Error{ErrorCode::kParse, "the stiffness matrix could not be factorized (degenerate tets?)"};
-  eigs.init();
+  if (start) {
+    // Lanczos keeps to the deflated space only if it starts there.
+    Eigen::VectorXd deflated = *start - rigid * ((fem.mass * rigid).transpose() * *start);
+    eigs.init(deflated.data());
+  } else {
+    eigs.init();
+  }
   eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
+  if (solves) *solves = static_cast<int>(eigs.num_operations());
   if (eigs.info() != Spectra::CompInfo::Successful)
     return Error{ErrorCode::kParse, "Lanczos did not converge on " + std::to_string(nev) + " modes"};
   return makeModalData(eigs.eigenvalues(), eigs.eigenvectors(), rigidEigenvalues, fem, options);
+}
+
+/// The seeds at every node of `mesh`: the corners' values as given, a mid-edge node's the mean of its
+/// edge's two corners (the quadratic interpolant of a field that is linear along the edge).
+Eigen::MatrixXd seedsAtAllNodes(const QuadraticTetMesh& mesh, const Eigen::MatrixXd& corners) {
+  Eigen::MatrixXd all(3 * static_cast<Eigen::Index>(mesh.nodeCount()), corners.cols());
+  all.topRows(corners.rows()) = corners;
+  for (const QuadraticTetMesh::Tet& tet : mesh.tets)
+    for (std::size_t e = 0; e < kQuadraticTetEdges.size(); ++e) {
+      const Eigen::Index at = 3 * static_cast<Eigen::Index>(tet[4 + e]);
+      const Eigen::Index a =
+          3 * static_cast<Eigen::Index>(tet[static_cast<std::size_t>(kQuadraticTetEdges[e][0])]);
+      const Eigen::Index b =
+          3 * static_cast<Eigen::Index>(tet[static_cast<std::size_t>(kQuadraticTetEdges[e][1])]);
+      all.middleRows(at, 3) = 0.5 * (corners.middleRows(a, 3) + corners.middleRows(b, 3));
+    }
+  return all;
 }
 
 /// All 3n eigenpairs by the dense solver: the six smallest must be the rigid ones.
@@ -468,6 +520,32 @@ Result<ModalData> computeModes(const TetMesh& mesh, const ModalOptions& options)
   }
   if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
   return solveSparse(mesh.nodes, assembleFem(mesh, options.material), options);
+}
+
+Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& seeds,
+                                   const ModalOptions& options, int* solves) {
+  if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
+  if (seeds.rows() != 3 * static_cast<Eigen::Index>(mesh.nodeCount()) || seeds.cols() < 1 ||
+      !seeds.allFinite())
+    return Error{ErrorCode::kInvalidArgument, "the seeds must be finite, 3 values per node of the tet mesh"};
+  // The start: the seeds' sum, each normalized, so that every seed mode is well represented in it.
+  const auto start = [](const FemMatrices& fem, const Eigen::MatrixXd& all) {
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(all.rows());
+    for (Eigen::Index j = 0; j < all.cols(); ++j) {
+      const double norm = std::sqrt(all.col(j).dot(fem.mass * all.col(j)));
+      if (norm > 0.0) sum += all.col(j) / norm;
+    }
+    return sum;
+  };
+  if (options.order == ElementOrder::kQuadratic) {
+    const QuadraticTetMesh quadratic = makeQuadratic(mesh);
+    const FemMatrices fem = assembleFem(quadratic, options.material);
+    const Eigen::VectorXd v = start(fem, seedsAtAllNodes(quadratic, seeds));
+    return cornersOnly(solveSparse(quadratic.nodes, fem, options, &v, solves), mesh.nodeCount());
+  }
+  const FemMatrices fem = assembleFem(mesh, options.material);
+  const Eigen::VectorXd v = start(fem, seeds);
+  return solveSparse(mesh.nodes, fem, options, &v, solves);
 }
 
 Result<ModalData> computeModesDense(const TetMesh& mesh, const ModalOptions& options) {

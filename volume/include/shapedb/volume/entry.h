@@ -14,22 +14,28 @@
 
 namespace shapedb::volume {
 
+/// TetGen's bounds for an entry whose modes use `order` elements. Quadratic tets need much coarser meshes
+/// for the same accuracy, and cost ~10x as much per tet: q3 and 1/100 of the volume (a third of the tet
+/// size gives frequencies a median 0.4 % and at most 4 % lower: docs/accuracy.md), against q1.5 and 1/600
+/// for linear ones (whose frequencies still come out high in bending).
+TetrahedralizeOptions entryMeshing(ElementOrder order);
+
 /// Everything that decides what a database entry holds. A database stores these with its entries: two
-/// entries built with different options are not comparable.
+/// entries built with different options are not comparable. The defaults are the default build's:
+/// quadratic tets at entryMeshing(kQuadratic).
 struct EntryOptions {
   /// Grid size, sampling and fill threshold of the voxel descriptors (`kind` is ignored: an entry gets
   /// all three).
   core::DescriptorOptions descriptor;
-  TetrahedralizeOptions tetgen;
-  ModalOptions modal;  ///< modes and Poisson ratio; E = ρ = 1 always
+  TetrahedralizeOptions tetgen = entryMeshing(ElementOrder::kQuadratic);
+  ModalOptions modal;  ///< modes, elements (quadratic) and Poisson ratio; E = ρ = 1 always
   CollisionOptions collision;
   core::RayleighDamping damping{
       .alpha = 2.0, .beta = 1e-6};  ///< for the sound data: α (1/s), β (s), applied to adapted frequencies
 };
 
-/// `options` with the modal analysis on `order` elements. Quadratic tets need much coarser meshes for the
-/// same accuracy (a plate of 545 of them is within 2 % of one six times finer), and cost ~10x as much per
-/// tet: their TetGen bounds become q3 and 1/100 of the volume (from q1.5 and 1/600).
+/// `options` with the modal analysis on `order` elements and the TetGen bounds that go with them
+/// (entryMeshing).
 EntryOptions withElements(EntryOptions options, ElementOrder order);
 
 /// Wall time of each stage of computeEntry, seconds.

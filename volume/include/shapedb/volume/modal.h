@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
 #include <shapedb/core/physics.h>
@@ -28,6 +29,11 @@ struct FemMaterial {
   double poissonRatio = 0.3;
   double density = 1.0;
 };
+
+/// The Poisson ratios the FEM takes, [0, 0.5) (auxetic materials are not modelled).
+constexpr bool validPoissonRatio(double nu) {
+  return nu >= 0.0 && nu < 0.5;
+}
 
 /// Assembles K and M. Preconditions: core::validateTetMesh(mesh) passed; 0 ≤ ν < 0.5.
 FemMatrices assembleFem(const core::TetMesh& mesh, const FemMaterial& material = {});
@@ -74,10 +80,10 @@ std::optional<ElementOrder> parseElementOrder(std::string_view name);
 struct ModalOptions {
   int modes = 20;  ///< non-rigid modes wanted, ≥ 1
   FemMaterial material;
-  /// Quadratic: the modes of the 10-node tets on the same mesh, their shapes reported at the linear
-  /// mesh's nodes (the corners; the mid-edge values are dropped). Linear by default, for now: the database
-  /// stores linear modes, and its tet meshes are too fine for quadratic ones within the build's budget.
-  ElementOrder order = ElementOrder::kLinear;
+  /// Quadratic (the default): the modes of the 10-node tets on the given mesh, their shapes reported at
+  /// its nodes (the corners; the mid-edge values are dropped). Linear: constant-strain tets, which lock in
+  /// bending (a plate two or three tets thick rings tens of per cent high) unless the mesh is very fine.
+  ElementOrder order = ElementOrder::kQuadratic;
 };
 
 /// The first `modes` non-rigid modes of the free body, K φ = λ M φ, by shift-invert Lanczos (Spectra)
@@ -91,6 +97,15 @@ Result<core::ModalData> computeModes(const core::TetMesh& mesh, const ModalOptio
 /// The modes on every node of the quadratic mesh (shapes 3·quadratic.nodeCount() × m), M-orthonormal for
 /// its mass matrix; computeModes of the quadratic order keeps their first 3·cornerCount rows.
 Result<core::ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOptions& options = {});
+
+/// computeModes started from approximate modes: `seeds` (3·mesh.nodeCount() × s, the corners' values;
+/// s ≥ 1, typically the modes of a similar mesh, such as the entry a mesh was morphed from) start the
+/// Lanczos recurrence instead of a random vector. The same modes as computeModes to its tolerance; the
+/// same cost, within a few solves (the first vector matters little to Lanczos). `solves`, when given,
+/// receives the number of solves with the factorized K − σM. Errors: computeModes', and
+/// kInvalidArgument for seeds of the wrong size or not finite.
+Result<core::ModalData> computeModesFrom(const core::TetMesh& mesh, const Eigen::MatrixXd& seeds,
+                                         const ModalOptions& options, int* solves = nullptr);
 
 /// The oracle: the same modes from a dense generalized eigensolver over all 3n degrees of freedom
 /// (Eigen's GeneralizedSelfAdjointEigenSolver, O(n³)), of options.order. For meshes of a few hundred nodes
