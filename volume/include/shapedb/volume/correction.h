@@ -1,0 +1,43 @@
+#pragma once
+// The geometry correction, the second tier of a query's answer (docs/architecture.md, "Geometry
+// correction"): the matched entry's tets morphed onto the query's own surface, and the modes computed
+// again on them, started from the entry's. The nearest entry gives the query the entry's proportions and
+// thin parts; the corrected data have the query's, at the entry's resolution.
+
+#include <shapedb/core/physics.h>
+#include <shapedb/core/result.h>
+#include <shapedb/core/triangle_mesh.h>
+#include <shapedb/volume/modal.h>
+#include <shapedb/volume/morph.h>
+
+namespace shapedb::volume {
+
+struct CorrectionOptions {
+  MorphOptions morph;
+};
+
+/// What the correction did and what it cost.
+struct CorrectionReport {
+  MorphReport morph;  ///< quality, moves, target coverage: in the entry's canonical frame (L = 1)
+  int solves = 0;     ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
+  double morphSeconds = 0.0;
+  double modesSeconds = 0.0;
+};
+
+/// The corrected entry: PhysicalData in the entry's canonical frame as a database entry's (so that
+/// core::adapt carries it to the query like any entry), with the morphed tets and their mass properties,
+/// the modes computed on them (unit density and Young's modulus, the entry's Poisson ratio), their sound
+/// frequencies; the collision compound is the entry's.
+struct CorrectedEntry {
+  core::PhysicalData physics;
+  CorrectionReport report;
+};
+
+/// Morphs `entry`'s tets onto `target` (the query's surface carried into the entry's canonical frame:
+/// unit volume, the entry's axes, core::Placement::toEntry) and computes their modes with `modal` (the
+/// database's: count, elements, Poisson ratio; E = ρ = 1), seeded by the entry's modes. Thread-safe.
+/// Errors: morphTetMesh's (the morph would invert a tet: keep the entry's data), computeModesFrom's.
+Result<CorrectedEntry> correctGeometry(const core::PhysicalData& entry, const core::TriangleMesh& target,
+                                       const ModalOptions& modal, const CorrectionOptions& options = {});
+
+}  // namespace shapedb::volume

@@ -1,0 +1,72 @@
+#pragma once
+// Morphing a tet mesh onto another surface: the geometry correction's first half (docs/architecture.md,
+// "Geometry correction"). A database entry's tets have the entry's proportions and thin parts; carried
+// onto the query's own surface they have the query's, and modes computed on them are the query's to
+// within what the entry's resolution can hold.
+
+#include <shapedb/core/physics.h>
+#include <shapedb/core/result.h>
+#include <shapedb/core/triangle_mesh.h>
+#include <shapedb/core/types.h>
+
+namespace shapedb::volume {
+
+/// How morphTetMesh moves the nodes.
+struct MorphOptions {
+  /// First stretch the whole mesh along x, y and z until its second moments equal the target's (an affine
+  /// map: every tet stays positive), so that the projection only has the non-affine rest to do.
+  bool prestretch = true;
+  /// Rounds of elastic registration before the final projection: each fits the mesh, as an elastic body,
+  /// to the target both ways (its boundary nodes to their closest target points, the target's points to
+  /// their closest boundary points), with a fit weight that grows round by round from stiff to close.
+  /// The second direction is what carries the boundary into the target's protrusions (a limb the entry
+  /// lacks), where closest points alone would never go. 0: projection only.
+  int registrationRounds = 4;
+  /// The boundary's displacement is carried into the interior in one increment or, where that would push a
+  /// tet under minQuality, in this many (the mesh-motion stiffness assembled again before each).
+  int maxIncrements = 8;
+  /// Worst mean-ratio quality a morphed tet may have (1: regular, 0: flat), or half the mesh's own worst
+  /// if that is lower. Below it a tet is nearly inverted, and its stiffness garbage: the morph goes no
+  /// further than this bound allows.
+  double minQuality = 0.02;
+};
+
+/// What the morph did, in the mesh's units.
+struct MorphReport {
+  core::Vec3 stretch = core::Vec3::Ones();  ///< the prestretch along x, y, z
+  double entryWorstQuality = 0.0;           ///< worst mean-ratio quality of a tet before the morph
+  double worstQuality = 0.0;                ///< after it
+  double maxBoundaryMove = 0.0;             ///< largest move of a boundary node, prestretch included
+  double meanBoundaryMove = 0.0;
+  /// Mean distance from the target's vertices to the morphed boundary: how much of the target the morphed
+  /// mesh does not reach (a handle the entry has no material for, say).
+  double meanTargetDistance = 0.0;
+  int increments = 0;  ///< increments of the final projection
+  /// The share of the final projection onto the target that was taken, weighted by area (1: the whole
+  /// boundary lies on the target). Less where the whole would have crushed a tet against a sharp edge of
+  /// the target: there the boundary nodes of those tets take ½, ¼, ⅛ or none of their move, and lie off
+  /// the target by the rest (see meanTargetDistance).
+  double projected = 0.0;
+};
+
+struct MorphResult {
+  core::TetMesh mesh;  ///< the input's tets over moved nodes, every tet positive
+  MorphReport report;
+};
+
+/// Mean-ratio quality of a tet: 12 (3|V|)^(2/3) / Σ (edge length)², 1 for the regular tet, 0 for a flat
+/// one; negative volumes give negative values.
+double tetQuality(const core::TetMesh& mesh, std::size_t t);
+
+/// Moves `mesh`'s boundary nodes onto `target` (a closed surface in the same frame and of about the same
+/// size and orientation: a query carried into its matched entry's canonical frame) and its inner nodes
+/// with them: prestretch; elastic registration; then every boundary node onto its closest target point,
+/// that last displacement extended into the interior as the displacement of an elastic body whose small
+/// tets are the stiffest (they deform least), in increments. Deterministic and thread-safe.
+/// Errors: kInvalidArgument (the mesh fails validateTetMesh, the target is empty or not finite, options
+/// out of range); kDegenerateFace when no part of the morph keeps every tet above minQuality (the message
+/// gives the quality reached): the caller keeps the unmorphed data.
+Result<MorphResult> morphTetMesh(const core::TetMesh& mesh, const core::TriangleMesh& target,
+                                 const MorphOptions& options = {});
+
+}  // namespace shapedb::volume

@@ -1,0 +1,419 @@
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/SparseCholesky>
+
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/spatial.h>
+#include <shapedb/volume/morph.h>
+
+namespace shapedb::volume {
+namespace {
+
+using core::TetMesh;
+using core::Vec3;
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// The boundary of a tet mesh as morphing sees it: which nodes lie on it, their neighbours along boundary
+/// edges, and the faces (for normals).
+struct Boundary {
+  std::vector<std::uint32_t> nodes;  ///< boundary nodes, ascending
+  std::vector<int> slot;             ///< per mesh node: its index in `nodes`, or -1 inside
+  std::vector<std::uint32_t> start;  ///< CSR over `nodes`: neighbours' slots
+  std::vector<std::uint32_t> neighbours;
+  std::vector<std::array<std::uint32_t, 3>> faces;  ///< slots, wound outward
+};
+
+Boundary findBoundary(const TetMesh& mesh) {
+  Boundary b;
+  b.slot.assign(mesh.nodeCount(), -1);
+  const std::vector<core::BoundaryFace> faces = core::boundaryFaces(mesh);
+  for (const core::BoundaryFace& f : faces)
+    for (std::uint32_t n : f.nodes)
+      b.slot[n] = 0;
+  for (std::uint32_t n = 0; n < mesh.nodeCount(); ++n)
+    if (b.slot[n] == 0) {
+      b.slot[n] = static_cast<int>(b.nodes.size());
+      b.nodes.push_back(n);
+    }
+  std::vector<std::uint64_t> edges;
+  for (const core::BoundaryFace& f : faces) {
+    std::array<std::uint32_t, 3> s{};
+    for (std::size_t i = 0; i < 3; ++i)
+      s[i] = static_cast<std::uint32_t>(b.slot[f.nodes[i]]);
+    b.faces.push_back(s);
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t p = s[i], q = s[(i + 1) % 3];
+      edges.push_back((static_cast<std::uint64_t>(p) << 32) | q);
+      edges.push_back((static_cast<std::uint64_t>(q) << 32) | p);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  b.start.assign(b.nodes.size() + 1, 0);
+  for (std::uint64_t e : edges) {
+    ++b.start[(e >> 32) + 1];
+    b.neighbours.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
+  }
+  for (std::size_t i = 0; i < b.nodes.size(); ++i)
+    b.start[i + 1] += b.start[i];
+  return b;
+}
+
+/// Per node of a tet mesh, the nodes that share a tet with it, itself included (CSR).
+struct NodeNeighbours {
+  std::vector<std::uint32_t> start;
+  std::vector<std::uint32_t> nodes;
+};
+
+NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
+  std::vector<std::uint64_t> pairs;
+  pairs.reserve(16 * mesh.tetCount());
+  for (const auto& tet : mesh.tets)
+    for (std::uint32_t a : tet)
+      for (std::uint32_t b : tet)
+        pairs.push_back((static_cast<std::uint64_t>(a) << 32) | b);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  NodeNeighbours out;
+  out.start.assign(mesh.nodeCount() + 1, 0);
+  out.nodes.reserve(pairs.size());
+  for (std::uint64_t p : pairs) {
+    ++out.start[(p >> 32) + 1];
+    out.nodes.push_back(static_cast<std::uint32_t>(p & 0xffffffffu));
+  }
+  for (std::size_t i = 0; i < mesh.nodeCount(); ++i)
+    out.start[i + 1] += out.start[i];
+  return out;
+}
+
+/// ∫ (x − c)(x − c)ᵀ dV at unit density, from the inertia about the centre of mass.
+core::Mat3 covariance(const core::MassProperties& m) {
+  return core::covarianceFromInertia(m.inertia / m.density);
+}
+
+double worstQuality(const TetMesh& mesh) {
+  double worst = 1.0;
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t)
+    worst = std::min(worst, tetQuality(mesh, t));
+  return worst;
+}
+
+/// Stiffness of the linear elastic body that carries the boundary's displacement inwards (ν = 0.3,
+/// constant-strain tets), each tet's modulus 1/V_t so that small tets, which a given displacement would
+/// distort most, move most rigidly (the "Jacobian-based stiffening" of mesh-moving methods).
+SparseMatrix meshMotionStiffness(const TetMesh& mesh) {
+  const double nu = 0.3, lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = 0.5 / (1.0 + nu);
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(144 * mesh.tetCount());
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
+    const auto [grad, volume] = core::tetGradients(mesh, t);
+    // Element stiffness ∫ λ div u div v + μ (∇u + ∇uᵀ) : ∇v over the tet, times 1/V: the V cancels.
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        const Vec3 ga = grad.col(a), gb = grad.col(b);
+        const core::Mat3 block = lambda * ga * gb.transpose() + mu * gb * ga.transpose() +
+                                 mu * ga.dot(gb) * core::Mat3::Identity();
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            triplets.emplace_back(3 * static_cast<int>(mesh.tets[t][static_cast<std::size_t>(a)]) + i,
+                                  3 * static_cast<int>(mesh.tets[t][static_cast<std::size_t>(b)]) + j,
+                                  block(i, j));
+      }
+  }
+  const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
+  SparseMatrix k(n, n);
+  k.setFromTriplets(triplets.begin(), triplets.end());
+  return k;
+}
+
+/// Moves the inner nodes of `mesh` for the boundary displacement `boundaryMove` (3 per boundary node):
+/// K_ii u_i = −K_ib u_b. Errors when the system cannot be factorized (a mesh with no inner node needs none).
+Status extendInwards(TetMesh& mesh, const Boundary& boundary, const Eigen::VectorXd& boundaryMove) {
+  const std::size_t n = mesh.nodeCount();
+  std::vector<int> inner(n, -1);
+  int innerCount = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    if (boundary.slot[v] < 0) inner[v] = innerCount++;
+  // Assembled on the mesh as it stands before this increment.
+  const SparseMatrix k = innerCount ? meshMotionStiffness(mesh) : SparseMatrix();
+  for (std::size_t i = 0; i < boundary.nodes.size(); ++i)
+    mesh.nodes[boundary.nodes[i]] += boundaryMove.segment<3>(3 * static_cast<Eigen::Index>(i));
+  if (innerCount == 0) return Ok{};
+  std::vector<Eigen::Triplet<double>> kii;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * innerCount);
+  for (int col = 0; col < k.outerSize(); ++col) {
+    const auto v = static_cast<std::size_t>(col / 3);
+    for (SparseMatrix::InnerIterator it(k, col); it; ++it) {
+      const auto u = static_cast<std::size_t>(it.row() / 3);
+      if (inner[u] < 0) continue;
+      const int row = 3 * inner[u] + static_cast<int>(it.row() % 3);
+      if (inner[v] >= 0)
+        kii.emplace_back(row, 3 * inner[v] + col % 3, it.value());
+      else
+        rhs[row] -= it.value() * boundaryMove[3 * boundary.slot[v] + col % 3];
+    }
+  }
+  SparseMatrix a(3 * innerCount, 3 * innerCount);
+  a.setFromTriplets(kii.begin(), kii.end());
+  Eigen::SimplicialLDLT<SparseMatrix> solver(a);
+  if (solver.info() != Eigen::Success)
+    return Error{ErrorCode::kInvalidArgument, "the mesh-motion system could not be factorized"};
+  const Eigen::VectorXd u = solver.solve(rhs);
+  for (std::size_t v = 0; v < n; ++v)
+    if (inner[v] >= 0) mesh.nodes[v] += u.segment<3>(3 * inner[v]);
+  return Ok{};
+}
+
+/// Per boundary node, a third of the area of its boundary faces at positions `nodes`.
+std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh) {
+  std::vector<double> area(boundary.nodes.size(), 0.0);
+  for (const auto& f : boundary.faces) {
+    const Vec3 &a = mesh.nodes[boundary.nodes[f[0]]], &b = mesh.nodes[boundary.nodes[f[1]]],
+               &c = mesh.nodes[boundary.nodes[f[2]]];
+    const double third = (b - a).cross(c - a).norm() / 6.0;
+    for (std::uint32_t s : f)
+      area[s] += third;
+  }
+  return area;
+}
+
+/// Elastic registration (the non-rigid ICP of Amberg et al. 2007, on a tet mesh): rounds of correspondences
+/// both ways, then the total displacement U that minimizes Uᵀ K U + w Σ (fit terms), K the mesh-motion
+/// stiffness of the start configuration, w growing round by round. A round whose displacement would push a
+/// tet under `minQuality` is taken in part (halved up to three times) or not at all.
+void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::TriangleMesh& target,
+                         const core::ClosestPointTree& targetTree, int rounds, double minQuality) {
+  if (rounds <= 0) return;
+  const TetMesh start = mesh;
+  const SparseMatrix k = meshMotionStiffness(start);
+  const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
+  const std::vector<double> nodeArea = boundaryAreas(boundary, start);
+  // The target's side: up to 2,000 of its vertices, each with its share of the target's area.
+  const std::vector<double> vertexArea = core::vertexAreaWeights(target);
+  const std::size_t stride = std::max<std::size_t>(1, target.vertices.size() / 2000);
+  double stiffnessScale = 0.0, fitScale = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i)
+    stiffnessScale += k.coeff(i, i);
+  for (double a : nodeArea)
+    fitScale += 3.0 * a;
+  Eigen::SimplicialLDLT<SparseMatrix> solver;
+  Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
+  for (int round = 0; round < rounds; ++round) {
+    // From stiff (the fit moves the body nearly as a whole) to close: w from 0.1 to 100 times the
+    // stiffness, in equal ratios.
+    const double ratio = rounds == 1 ? 1.0 : std::pow(1000.0, static_cast<double>(round) / (rounds - 1));
+    const double w = 0.1 * ratio * stiffnessScale / fitScale;
+    std::vector<Eigen::Triplet<double>> fit;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+    const auto addPoint = [&](std::span<const std::uint32_t> nodes, std::span<const double> weights,
+                              const Vec3& goal, double weight) {
+      // weight · |Σ βᵢ (xᵢ + Uᵢ) − goal|², with x the start configuration.
+      Vec3 at = Vec3::Zero();
+      for (std::size_t i = 0; i < nodes.size(); ++i)
+        at += weights[i] * start.nodes[nodes[i]];
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        for (std::size_t j = 0; j < nodes.size(); ++j)
+          for (int c = 0; c < 3; ++c)
+            fit.emplace_back(3 * static_cast<int>(nodes[i]) + c, 3 * static_cast<int>(nodes[j]) + c,
+                             weight * weights[i] * weights[j]);
+        rhs.segment<3>(3 * static_cast<Eigen::Index>(nodes[i])) += weight * weights[i] * (goal - at);
+      }
+    };
+    // Boundary nodes to their closest target points.
+    for (std::size_t b = 0; b < boundary.nodes.size(); ++b) {
+      const std::uint32_t node = boundary.nodes[b];
+      const double one = 1.0;
+      addPoint({&node, 1}, {&one, 1}, targetTree.closest(mesh.nodes[node]).closest.point, w * nodeArea[b]);
+    }
+    // Target points to their closest boundary points (a face of the current boundary, by barycentric
+    // weights).
+    const core::TriangleMesh current = [&] {
+      core::TriangleMesh surface;
+      surface.vertices = mesh.nodes;
+      for (const auto& f : boundary.faces)
+        surface.triangles.push_back({boundary.nodes[f[0]], boundary.nodes[f[1]], boundary.nodes[f[2]]});
+      return surface;
+    }();
+    const core::ClosestPointTree currentTree(current);
+    for (std::size_t v = 0; v < target.vertices.size(); v += stride) {
+      const core::ClosestPointTree::Hit hit = currentTree.closest(target.vertices[v]);
+      const auto& t = current.triangles[hit.triangle];
+      addPoint(t, hit.closest.barycentric, target.vertices[v],
+               w * vertexArea[v] * static_cast<double>(stride));
+    }
+    SparseMatrix a(n, n);
+    a.setFromTriplets(fit.begin(), fit.end());
+    a += k;
+    if (round == 0) solver.analyzePattern(a);
+    solver.factorize(a);
+    if (solver.info() != Eigen::Success) break;
+    // The fit terms hold the start configuration's rigid motions, so the system is definite.
+    const Eigen::VectorXd next = solver.solve(rhs);
+    // Take the round's step, or as much of it as keeps every tet above the bound.
+    bool taken = false;
+    for (double t = 1.0; t >= 0.125 && !taken; t *= 0.5) {
+      const Eigen::VectorXd u = total + t * (next - total);
+      TetMesh moved = start;
+      for (std::size_t v = 0; v < moved.nodeCount(); ++v)
+        moved.nodes[v] += u.segment<3>(3 * static_cast<Eigen::Index>(v));
+      if (worstQuality(moved) >= minQuality) {
+        mesh = std::move(moved);
+        total = u;
+        taken = true;
+      }
+    }
+    if (!taken) break;
+  }
+}
+
+}  // namespace
+
+double tetQuality(const TetMesh& mesh, std::size_t t) {
+  const auto& tet = mesh.tets[t];
+  double edges = 0.0;
+  for (std::size_t i = 0; i < 4; ++i)
+    for (std::size_t j = i + 1; j < 4; ++j)
+      edges += (mesh.nodes[tet[i]] - mesh.nodes[tet[j]]).squaredNorm();
+  const double volume = core::tetVolume(mesh, t);
+  const double q = 12.0 * std::cbrt(9.0 * volume * volume) / edges;
+  return volume < 0.0 ? -q : q;
+}
+
+Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& target,
+                                 const MorphOptions& options) {
+  if (Status valid = core::validateTetMesh(mesh); !valid)
+    return Error{ErrorCode::kInvalidArgument, "morph: the tet mesh is not valid: " + valid.error().message};
+  if (Status valid = core::validateMesh(target); !valid)
+    return Error{ErrorCode::kInvalidArgument,
+                 "morph: the target surface is not valid: " + valid.error().message};
+  if (options.registrationRounds < 0 || options.maxIncrements < 1 ||
+      !(options.minQuality > 0.0 && options.minQuality < 1.0))
+    return Error{ErrorCode::kInvalidArgument,
+                 "morph: registrationRounds ≥ 0, maxIncrements ≥ 1 and minQuality in (0, 1)"};
+
+  MorphResult out;
+  out.mesh = mesh;
+  out.report.entryWorstQuality = worstQuality(mesh);
+  // An entry that has worse tets than the bound may keep them: the bound is then half its worst.
+  const double minQuality = std::min(options.minQuality, 0.5 * out.report.entryWorstQuality);
+
+  // The affine part first: the stretch that gives the tets the target's second moments along x, y, z.
+  if (options.prestretch) {
+    auto targetMass = core::computeMassProperties(target);
+    if (targetMass) {
+      const core::MassProperties own = core::computeTetMassProperties(mesh);
+      const Vec3 a = (covariance(*targetMass).diagonal().array() / covariance(own).diagonal().array()).sqrt();
+      if (a.allFinite() && (a.array() > 0.0).all()) {
+        out.report.stretch = a;
+        for (Vec3& p : out.mesh.nodes)
+          p = own.centerOfMass + a.cwiseProduct(p - own.centerOfMass);
+      }
+    }
+  }
+
+  // Elastic registration, then every boundary node onto its closest target point.
+  const Boundary boundary = findBoundary(out.mesh);
+  const core::ClosestPointTree tree(target);
+  registerElastically(out.mesh, boundary, target, tree, options.registrationRounds, minQuality);
+  std::vector<Vec3> p(boundary.nodes.size());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    p[i] = tree.closest(out.mesh.nodes[boundary.nodes[i]]).closest.point;
+  Eigen::VectorXd move(3 * static_cast<Eigen::Index>(p.size()));
+  for (std::size_t i = 0; i < p.size(); ++i)
+    move.segment<3>(3 * static_cast<Eigen::Index>(i)) = p[i] - out.mesh.nodes[boundary.nodes[i]];
+
+  // The interior follows, in as few increments as keep every tet above the quality bound. Where even the
+  // finest increments would not (nodes the projection crowds onto a sharp edge of the target, or the four
+  // boundary nodes of a tet flattened onto one face), the boundary nodes of the tets that fell under the
+  // bound and of their neighbours take half their projection, round by round (½, ¼, ⅛, then none): the rest
+  // of the boundary still goes all the way onto the target.
+  const TetMesh start = out.mesh;
+  const double reached = worstQuality(start);
+  std::vector<double> taken(boundary.nodes.size(), 1.0);
+  const std::array<int, 2> incrementSteps{1, options.maxIncrements};
+  bool done = false;
+  const NodeNeighbours neighbours = nodeNeighbours(mesh);
+  constexpr int kRounds = 8;
+  for (int round = 0; round < kRounds && !done; ++round) {
+    const bool last = round == kRounds - 1;
+    if (last) std::fill(taken.begin(), taken.end(), 0.0);
+    Eigen::VectorXd step = move;
+    for (std::size_t i = 0; i < taken.size(); ++i)
+      step.segment<3>(3 * static_cast<Eigen::Index>(i)) *= taken[i];
+    std::vector<std::size_t> bad;
+    for (const int increments : incrementSteps) {
+      TetMesh moved = start;
+      for (int k = 0; k < increments; ++k)
+        if (Status st = extendInwards(moved, boundary, step / increments); !st) return st.error();
+      bad.clear();
+      for (std::size_t t = 0; t < moved.tetCount(); ++t)
+        if (tetQuality(moved, t) < minQuality) bad.push_back(t);
+      if (bad.empty()) {
+        out.mesh = std::move(moved);
+        out.report.increments = increments;
+        done = true;
+        break;
+      }
+      if (increments == options.maxIncrements) break;
+    }
+    if (done || last) break;
+    // Hold back the boundary nodes of the tets that fell under the bound and of their neighbours (a tet
+    // inside is crushed by the boundary nodes around it); where all of those are held back already, the
+    // whole boundary.
+    std::vector<char> hold(taken.size(), 0);
+    for (std::size_t t : bad)
+      for (std::uint32_t node : mesh.tets[t])
+        for (std::uint32_t k = neighbours.start[node]; k < neighbours.start[node + 1]; ++k)
+          if (const int slot = boundary.slot[neighbours.nodes[k]]; slot >= 0)
+            hold[static_cast<std::size_t>(slot)] = 1;
+    bool held = false;
+    for (std::size_t i = 0; i < taken.size(); ++i)
+      if (hold[i] && taken[i] > 0.0) {
+        taken[i] = taken[i] < 0.2 ? 0.0 : 0.5 * taken[i];
+        held = true;
+      }
+    if (!held)
+      for (double& share : taken)
+        share = share < 0.2 ? 0.0 : 0.5 * share;
+  }
+  if (!done && reached < minQuality)
+    return Error{ErrorCode::kDegenerateFace, "morph: a tet would fall to quality " + std::to_string(reached) +
+                                                 " (bound " + std::to_string(minQuality) +
+                                                 "): the target is too far from the mesh's shape"};
+  if (!done) out.mesh = start;
+  // The share of the projection taken, weighted by the boundary nodes' areas.
+  const std::vector<double> nodeArea = boundaryAreas(boundary, start);
+  double area = 0.0, projected = 0.0;
+  for (std::size_t i = 0; i < taken.size(); ++i) {
+    area += nodeArea[i];
+    projected += nodeArea[i] * (done ? taken[i] : 0.0);
+  }
+  out.report.projected = area > 0.0 ? projected / area : 0.0;
+  out.report.worstQuality = worstQuality(out.mesh);
+
+  // How far the boundary went, prestretch included, and how much of the target it leaves out (over at
+  // most 2,000 of the target's vertices).
+  double sum = 0.0;
+  for (std::uint32_t node : boundary.nodes) {
+    const double d = (out.mesh.nodes[node] - mesh.nodes[node]).norm();
+    out.report.maxBoundaryMove = std::max(out.report.maxBoundaryMove, d);
+    sum += d;
+  }
+  out.report.meanBoundaryMove =
+      boundary.nodes.empty() ? 0.0 : sum / static_cast<double>(boundary.nodes.size());
+  const core::ClosestPointTree morphed(core::boundarySurface(out.mesh));
+  const std::size_t stride = std::max<std::size_t>(1, target.vertices.size() / 2000);
+  double distance = 0.0;
+  std::size_t count = 0;
+  for (std::size_t v = 0; v < target.vertices.size(); v += stride, ++count)
+    distance += std::sqrt(morphed.closest(target.vertices[v]).closest.squaredDistance);
+  out.report.meanTargetDistance = distance / static_cast<double>(count);
+  return out;
+}
+
+}  // namespace shapedb::volume
