@@ -35,6 +35,7 @@ struct QueryCommandOptions {
   bool timing = false;
   bool noFidelity = false;
   bool stretch = false;
+  bool correct = false;
   bool table = false;
   std::string exportDir;
   std::string png;
@@ -92,12 +93,25 @@ nlohmann::json physicsJson(const core::AdaptedPhysics& p) {
           {"warnings", p.warnings}};
 }
 
+nlohmann::json correctionJson(const volume::CorrectionReport& c) {
+  return {{"prestretch", toJson(c.morph.stretch)},
+          {"entry_worst_quality", c.morph.entryWorstQuality},
+          {"worst_quality", c.morph.worstQuality},
+          {"max_boundary_move", c.morph.maxBoundaryMove},
+          {"mean_boundary_move", c.morph.meanBoundaryMove},
+          {"mean_target_distance", c.morph.meanTargetDistance},
+          {"projected", c.morph.projected},
+          {"solves", c.solves},
+          {"morph_seconds", c.morphSeconds},
+          {"modes_seconds", c.modesSeconds}};
+}
+
 nlohmann::json timingJson(const io::QueryTimes& t) {
   return {{"validate", t.validate}, {"mass_properties", t.massProperties},
           {"describe", t.describe}, {"search", t.search},
-          {"fetch", t.fetch},       {"adapt", t.adapt},
-          {"link", t.link},         {"fidelity", t.fidelity},
-          {"total", t.total}};
+          {"fetch", t.fetch},       {"correct", t.correct},
+          {"adapt", t.adapt},       {"link", t.link},
+          {"fidelity", t.fidelity}, {"total", t.total}};
 }
 
 std::string percent(double x) {
@@ -141,6 +155,15 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
       std::printf(
           "    modes of the entry stretched by %.3f, %.3f, %.3f along its axes (to the mesh's proportions)\n",
           p.stretch.x(), p.stretch.y(), p.stretch.z());
+    if (r.correction) {
+      const volume::MorphReport& m = r.correction->morph;
+      std::printf(
+          "    corrected: the entry's tets morphed onto the mesh (boundary moved up to %.3g L, worst tet "
+          "quality "
+          "%.3g, was %.3g; the mesh lies %.3g L from them on average), modes recomputed (%.1f + %.1f ms)\n",
+          m.maxBoundaryMove, m.worstQuality, m.entryWorstQuality, m.meanTargetDistance,
+          1e3 * r.correction->morphSeconds, 1e3 * r.correction->modesSeconds);
+    }
     if (!r.link.locations.empty())
       std::printf("    linked %zu vertices, %zu outside the tets (max %.3g m)\n", r.link.locations.size(),
                   r.link.outsideCount, r.link.maxOutsideDistance);
@@ -151,9 +174,9 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
     const io::QueryTimes& t = r.times;
     std::printf(
         "  timing (µs): validate %.1f, mass properties %.1f, describe %.1f (%zu orientations), search %.1f, "
-        "fetch %.1f, adapt %.1f, link %.1f, fidelity %.1f, total %.1f\n",
-        t.validate, t.massProperties, t.describe, r.orientationCandidates, t.search, t.fetch, t.adapt, t.link,
-        t.fidelity, t.total);
+        "fetch %.1f, correct %.1f, adapt %.1f, link %.1f, fidelity %.1f, total %.1f\n",
+        t.validate, t.massProperties, t.describe, r.orientationCandidates, t.search, t.fetch, t.correct,
+        t.adapt, t.link, t.fidelity, t.total);
   }
 }
 
@@ -233,6 +256,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   options.search.momentWeight = o.momentWeight;
   options.fidelity = !o.noFidelity;
   options.stretchCorrection = o.stretch;
+  options.correct = o.correct;
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
   options.material = *material;
@@ -282,6 +306,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
       if (!result->matches.empty() && result->matches.front().fidelity)
         q["fidelity"] = matchJson(result->matches.front())["fidelity"];
       if (result->physics) q["physics"] = physicsJson(*result->physics);
+      if (result->correction) q["correction"] = correctionJson(*result->correction);
       q["link"] = {{"vertices", result->link.locations.size()},
                    {"outside", result->link.outsideCount},
                    {"max_outside_distance", result->link.maxOutsideDistance}};
@@ -343,6 +368,13 @@ Command addQueryCommand(CLI::App& parent) {
                 "proportions (second moments), by Rayleigh-Ritz on its modes, instead of scaling it\n"
                 "uniformly as the paper does (~1 ms more per query; databases of linear tets only;\n"
                 "docs/architecture.md)");
+  app->add_flag(
+         "--correct", o->correct,
+         "Geometry correction: morph the best entry's tets onto the mesh's own surface and compute\n"
+         "their modes again there, so that the data have the mesh's proportions and thin parts, not\n"
+         "the entry's (tens of ms per query; where the morph would invert a tet, the entry's own data\n"
+         "stand, with a warning). JSON gains \"correction\": the morph's quality and cost")
+      ->excludes(app->get_option("--stretch"));
   return {app, [o, app] { return runQuery(*o, *app); }};
 }
 

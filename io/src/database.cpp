@@ -392,6 +392,10 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   QueryResult out;
   if (options.adapt)
     if (Status valid = core::validateMaterial(options.material); !valid) return valid.error();
+  if (options.adapt && options.stretchCorrection && options.correct)
+    return Error{ErrorCode::kInvalidArgument,
+                 "the stretch correction and the geometry correction exclude each other: the geometry "
+                 "correction gives the entry the query's whole shape, proportions included"};
   if (options.adapt && options.stretchCorrection && !supportsStretchCorrection())
     return Error{ErrorCode::kInvalidArgument,
                  "the stretch correction needs a database of linear tets; " + mImpl->store.path().string() +
@@ -442,17 +446,47 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   out.entryPhysics = std::shared_ptr<const core::PhysicalData>(entries.front(), &best.data);
 
   if (options.adapt) {
+    // The geometry correction first, in the entry's canonical frame: the query's surface carried there,
+    // the entry's tets morphed onto it and their modes computed again.
+    const core::Placement placement =
+        core::placementOf(out.normalization, out.matches.front().match.orientation);
+    std::optional<volume::CorrectedEntry> corrected;
+    std::optional<core::TetLocator> correctedLocator;
+    std::string correctionWarning;
+    if (options.correct) {
+      t = Clock::now();
+      core::TriangleMesh target = mesh;
+      for (core::Vec3& p : target.vertices)
+        p = placement.toEntry(p);
+      // The modes are computed again anyway: with the material's own Poisson ratio where the FEM takes it.
+      volume::ModalOptions modal = parameters().entry.modal;
+      if (volume::validPoissonRatio(options.material.poissonRatio))
+        modal.material.poissonRatio = options.material.poissonRatio;
+      auto c = volume::correctGeometry(best.data, target, modal, options.correction);
+      if (c) {
+        out.correction = c->report;
+        corrected = std::move(c).value();
+        correctedLocator.emplace(corrected->physics.tetMesh);
+      } else {
+        correctionWarning =
+            "geometry correction not applied (the entry's own data stand): " + c.error().message;
+      }
+      out.times.correct = microsecondsSince(t);
+    }
+    const core::PhysicalData& data = corrected ? corrected->physics : best.data;
+    const core::TetLocator& locator = corrected ? *correctedLocator : best.locator;
+
     t = Clock::now();
-    auto adapted =
-        core::adapt(best.data, out.normalization, out.massProperties, out.matches.front().match.orientation,
-                    options.material, parameters().entry.damping,
-                    options.stretchCorrection ? &best.stretchBasis() : nullptr);
+    auto adapted = core::adapt(
+        data, out.normalization, out.massProperties, out.matches.front().match.orientation, options.material,
+        parameters().entry.damping, options.stretchCorrection ? &best.stretchBasis() : nullptr);
     if (!adapted) return adapted.error();
     out.physics = std::move(adapted).value();
+    if (!correctionWarning.empty()) out.physics->warnings.push_back(correctionWarning);
     out.times.adapt = microsecondsSince(t);
     if (options.link) {
       t = Clock::now();
-      out.link = core::linkSurface(best.locator, out.physics->placement, mesh.vertices);
+      out.link = core::linkSurface(locator, out.physics->placement, mesh.vertices);
       out.times.link = microsecondsSince(t);
     }
   }

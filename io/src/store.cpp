@@ -93,6 +93,14 @@ volume::StageTimes timesFromJson(const json& j) {
 
 }  // namespace
 
+BuildParameters withElements(BuildParameters parameters, volume::ElementOrder order) {
+  parameters.entry = volume::withElements(parameters.entry, order);
+  parameters.resolution = order == volume::ElementOrder::kQuadratic
+                              ? volume::ShapeResolution{.segments = 16, .stacks = 8}
+                              : volume::ShapeResolution{.segments = 24, .stacks = 12};
+  return parameters;
+}
+
 std::string toJson(const BuildParameters& p) {
   const volume::EntryOptions& e = p.entry;
   json families = json::array();

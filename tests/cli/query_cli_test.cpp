@@ -3,13 +3,16 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <random>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <shapedb/core/adapt.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
+#include <shapedb/volume/entry.h>
 
 #include "support/subprocess.h"
 #include "support/test_support.h"
@@ -88,19 +91,43 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   EXPECT_EQ(pb["matches"][0]["moment_term"].get<double>(), 0.0);
   EXPECT_LE(b["fidelity"]["max_moment_error"].get<double>(),
             pb["fidelity"]["max_moment_error"].get<double>());
-  // Scaled uniformly by default; with --stretch, the matched box entry takes the query's proportions.
+  // Scaled uniformly by default; with --correct, the matched entry's tets are morphed onto the box and
+  // their modes computed again: the frequencies of the 3:2:1 box itself, computed directly here.
   EXPECT_EQ(p["stretch"], nlohmann::json::parse("[1.0, 1.0, 1.0]"));
-  test::ProcessResult stretched = test::runProcess(
-      SHAPEDB_CLI, {"query", db.string(), box.string(), "--material", "aluminium", "--json", "--stretch"});
-  ASSERT_EQ(stretched.exitCode, 0) << stretched.err;
-  const nlohmann::json sj = nlohmann::json::parse(stretched.out);
-  const nlohmann::json& sp = sj["queries"][0]["physics"];
-  ASSERT_EQ(sp["stretch"].size(), 3u);
-  for (const auto& a : sp["stretch"])
-    EXPECT_GT(a.get<double>(), 0.0);
-  EXPECT_NE(sp["stretch"], p["stretch"]);  // three box entries: none is 3:2:1
-  EXPECT_EQ(sp["mass"], p["mass"]);
-  EXPECT_NE(sp["frequencies_hz"], p["frequencies_hz"]);
+  EXPECT_FALSE(b.contains("correction"));
+  test::ProcessResult corrected = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), box.string(), "--material", "aluminium", "--json", "--correct"});
+  ASSERT_EQ(corrected.exitCode, 0) << corrected.err;
+  const nlohmann::json cj = nlohmann::json::parse(corrected.out)["queries"][0];
+  ASSERT_TRUE(cj.contains("correction")) << corrected.out;
+  EXPECT_GT(cj["correction"]["worst_quality"].get<double>(), 0.0);
+  EXPECT_GT(cj["correction"]["max_boundary_move"].get<double>(), 0.0);
+  EXPECT_TRUE(cj["physics"]["warnings"].empty()) << cj["physics"]["warnings"];
+  EXPECT_EQ(cj["physics"]["mass"], p["mass"]);
+  // The correction computes the modes for aluminium's own Poisson ratio: so does the direct computation.
+  const core::Material aluminium = *core::materialPreset("aluminium");
+  volume::EntryOptions entry;
+  entry.modal.material.poissonRatio = aluminium.poissonRatio;
+  auto direct = volume::computeEntry(core::makeBox({0.3, 0.2, 0.1}), entry);
+  ASSERT_TRUE(direct.ok()) << direct.error().message;
+  const double hz =
+      std::sqrt(direct->physics.modes.eigenvalues[0] * aluminium.youngsModulus / aluminium.density) /
+      (2.0 * std::numbers::pi * std::cbrt(0.3 * 0.2 * 0.1));
+  const double uncorrectedError = p["frequencies_hz"][0].get<double>() / hz - 1.0;
+  const double correctedError = cj["physics"]["frequencies_hz"][0].get<double>() / hz - 1.0;
+  std::printf("3:2:1 box f1 %.1f Hz: uncorrected %+.1f %%, corrected %+.2f %%\n", hz,
+              100.0 * uncorrectedError, 100.0 * correctedError);
+  EXPECT_LT(std::abs(correctedError), 0.05);  // another family's tets, morphed: within the entry's resolution
+  EXPECT_LT(std::abs(correctedError), std::abs(uncorrectedError));
+  // --stretch needs a database of linear tets: refused here, with the reason; and with --correct, a usage
+  // error.
+  test::ProcessResult refused =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), box.string(), "--json", "--stretch"});
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(refused.err.find("linear tets"), std::string::npos) << refused.err;
+  EXPECT_EQ(
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), box.string(), "--stretch", "--correct"}).exitCode,
+      2);
 
   // Files beside the queries: two PNGs (one per mesh), and OBJs of the adapted volume and compound.
   for (const char* name : {"side-1.png", "side-2.png"})

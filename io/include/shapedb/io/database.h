@@ -17,6 +17,7 @@
 #include <shapedb/core/result.h>
 #include <shapedb/core/triangle_mesh.h>
 #include <shapedb/io/store.h>
+#include <shapedb/volume/correction.h>
 
 namespace shapedb::io {
 
@@ -83,6 +84,13 @@ struct QueryOptions {
   /// it narrows the worst errors more than the median (docs/architecture.md).
   /// Linear-tet databases only (supportsStretchCorrection): an error otherwise.
   bool stretchCorrection = false;
+  /// With adapt: the geometry correction, the second tier of the answer (volume/correction.h): the best
+  /// entry's tets morphed onto the query's own surface and their modes computed again there, before they
+  /// are adapted and linked. Tens of milliseconds where the nearest entry takes one: run it on a worker
+  /// thread beside an interactive loop. Where the morph cannot keep every tet positive, the entry's own
+  /// data stand and physics->warnings says why. Not with stretchCorrection (this replaces it).
+  bool correct = false;
+  volume::CorrectionOptions correction;
   bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
   core::FidelityOptions fidelityOptions;
 };
@@ -93,7 +101,8 @@ struct QueryTimes {
   double massProperties = 0.0;  ///< exact mass properties (surface integrals) + normalize
   double describe = 0.0;        ///< every orientation candidate
   double search = 0.0;
-  double fetch = 0.0;  ///< physical data from the cache or the file (with the entry's locator)
+  double fetch = 0.0;    ///< physical data from the cache or the file (with the entry's locator)
+  double correct = 0.0;  ///< the geometry correction: morph and modes (QueryOptions::correct)
   double adapt = 0.0;
   double link = 0.0;
   double fidelity = 0.0;
@@ -113,9 +122,14 @@ struct QueryResult {
   core::Normalization normalization;
   std::vector<MatchReport> matches;
   std::shared_ptr<const core::PhysicalData> entryPhysics;  ///< the best match's, canonical frame
-  std::optional<core::AdaptedPhysics> physics;             ///< with QueryOptions::adapt
-  core::SurfaceLink link;                                  ///< with QueryOptions::link
-  std::size_t orientationCandidates = 0;                   ///< descriptors searched (orientations)
+  /// With QueryOptions::correct, what the correction did (also when it failed: then only the reason in
+  /// physics->warnings, and this is empty).
+  std::optional<volume::CorrectionReport> correction;
+  /// With adapt: the best match's data (or, corrected, the data of its tets morphed onto the query) in the
+  /// query's frame, size and material.
+  std::optional<core::AdaptedPhysics> physics;
+  core::SurfaceLink link;                 ///< with QueryOptions::link
+  std::size_t orientationCandidates = 0;  ///< descriptors searched (orientations)
   QueryTimes times;
 };
 
