@@ -125,7 +125,7 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
   if (!fs::is_directory(directory, ec))
     return Error{ErrorCode::kIo, directory.string() + ": not a directory"};
   std::vector<fs::path> files;
-  for (const fs::directory_entry& entry : fs::directory_iterator(directory, ec)) {
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(directory, ec)) {
     std::string extension = entry.path().extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

@@ -27,8 +27,9 @@ namespace shapedb::io {
 /// voxel kinds ranked with their moment term, core::SearchOptions::momentWeight), or the
 /// inertia-equivalent solid ellipsoid (the precomputed sound banks of Zheng & James 2010, at their
 /// best: the exact ellipsoid rather than the nearest precomputed one) or box; the centroid-voxel match
-/// adapted with the stretch correction (core/stretch.h; its time added to the query's); and the
-/// centroid-voxel match by the paper's distance alone (eq. 6, no moment term).
+/// adapted with the stretch correction (core/stretch.h; its time added to the query's); the centroid-voxel
+/// match by the paper's distance alone (eq. 6, no moment term); and the centroid-voxel query with the
+/// geometry correction (volume/correction.h: the entry's tets morphed onto the shape, modes recomputed).
 enum class EvaluationMethod {
   kMoment,
   kVoxel,
@@ -36,17 +37,20 @@ enum class EvaluationMethod {
   kEllipsoid,
   kBox,
   kCentroidVoxelStretched,
-  kCentroidVoxelPaper
+  kCentroidVoxelPaper,
+  kCentroidVoxelCorrected
 };
-inline constexpr std::array<EvaluationMethod, 7> kEvaluationMethods{EvaluationMethod::kMoment,
-                                                                    EvaluationMethod::kVoxel,
-                                                                    EvaluationMethod::kCentroidVoxel,
-                                                                    EvaluationMethod::kEllipsoid,
-                                                                    EvaluationMethod::kBox,
-                                                                    EvaluationMethod::kCentroidVoxelStretched,
-                                                                    EvaluationMethod::kCentroidVoxelPaper};
+inline constexpr std::array<EvaluationMethod, 8> kEvaluationMethods{
+    EvaluationMethod::kMoment,
+    EvaluationMethod::kVoxel,
+    EvaluationMethod::kCentroidVoxel,
+    EvaluationMethod::kEllipsoid,
+    EvaluationMethod::kBox,
+    EvaluationMethod::kCentroidVoxelStretched,
+    EvaluationMethod::kCentroidVoxelPaper,
+    EvaluationMethod::kCentroidVoxelCorrected};
 /// "moment", "voxel", "centroid-voxel", "ellipsoid", "box", "centroid-voxel-stretched",
-/// "centroid-voxel-paper".
+/// "centroid-voxel-paper", "centroid-voxel-corrected".
 const char* toString(EvaluationMethod method);
 
 struct MethodEvaluation {
@@ -63,7 +67,7 @@ struct MethodEvaluation {
   double maxFrequencyError = kNaN;
   /// The collision proxy (the adapted compound; the baselines' own solid) against the shape's volume.
   core::VolumeOverlap overlap;
-  double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, adapt, link)
+  double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link)
   double matchMicros = kNaN;  ///< descriptors: validate, mass properties, describe, search
 };
 
@@ -77,9 +81,14 @@ struct FragmentEvaluation {
   Eigen::VectorXd truthFrequenciesHz;  ///< computed directly on the shape
   double truthSeconds = 0.0;           ///< tetrahedralize + modes + collision compound, wall time
   std::size_t truthTets = 0;
+  /// Triangles of the surface the truth was computed on: the shape's own, or fewer where it had more
+  /// than EvaluationOptions::truthMaxTriangles and was simplified first.
+  std::size_t truthTriangles = 0;
   std::vector<MethodEvaluation> methods;  ///< kEvaluationMethods' order
   /// Direct computation over the centroid-voxel query's time: what the database saves.
   double speedup() const;
+  /// The same over the corrected query's time.
+  double correctedSpeedup() const;
   bool ok() const { return error.empty(); }
 };
 
@@ -88,10 +97,17 @@ struct EvaluationOptions {
   int frequencies = 5;         ///< non-rigid frequencies compared (at most the database's modes)
   int overlapResolution = 48;  ///< sampling grid of the volume overlap, cells along the longest side
   int threads = 0;             ///< for the direct computations; 0: all cores
-  /// Elements of the direct computations (the truth and both baselines), with their TetGen bounds
-  /// (volume::withElements); unset: the database's own. Quadratic ones do not lock in bending, so they
-  /// are the better truth for a database of either kind.
-  std::optional<volume::ElementOrder> directElements;
+  /// Elements of the direct computations (the truth and both baselines). Quadratic ones do not lock in
+  /// bending, so they are the better truth for a database of either kind.
+  volume::ElementOrder directElements = volume::ElementOrder::kQuadratic;
+  /// The truth is meshed finer than the database's entries, so that its own error is small against the
+  /// errors it measures: TetGen's volume bound (volume::entryMeshing of directElements) divided by this,
+  /// and the quality bound 1.5 at most. The baselines are meshed as entries are.
+  double truthRefinement = 8.0;
+  /// A shape of more triangles is simplified to about this many (volume::simplify, within 1e-3 of its
+  /// size L) before its truth is computed: the tets of a 100k-triangle scan would not fit the memory of a
+  /// quadratic solve. Its queries see the shape as it is.
+  std::size_t truthMaxTriangles = 8000;
   /// Called after each shape's direct computation, from one thread at a time: done, total, its name.
   std::function<void(std::size_t, std::size_t, const std::string&)> progress;
 };

@@ -36,7 +36,8 @@ struct LoadedMesh {
 /// kParse, kEmptyMesh, kNonFinite, kIndexOutOfRange, kDegenerateFace. Thread-safe.
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options = {});
 
-/// The mesh files (.obj, .ply, .off, .stl, any case) directly in `directory`, sorted by name.
+/// The mesh files (.obj, .ply, .off, .stl, any case) in `directory` and its subdirectories, sorted by
+/// path.
 /// Errors: kIo (not a directory, unreadable, or no mesh file in it), naming the directory.
 Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::path& directory);
 
