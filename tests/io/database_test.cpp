@@ -270,6 +270,28 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
   }
 }
 
+// A query that no entry's tets can be morphed onto (a needle, 60 : 1 : 1, far beyond every entry's
+// proportions): the correction is refused, and the answer is the uncorrected one, with the reason.
+TEST_F(SmallDatabase, ACorrectionThatWouldInvertATetKeepsTheEntrysDataAndSaysWhy) {
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  const core::TriangleMesh needle = core::makeBox({0.6, 0.01, 0.01});
+  QueryOptions options;
+  options.fidelity = false;
+  auto plain = db->query(needle, options);
+  ASSERT_TRUE(plain.ok() && plain->physics) << (plain ? "" : plain.error().message);
+  options.correct = true;
+  auto r = db->query(needle, options);
+  ASSERT_TRUE(r.ok() && r->physics) << (r ? "" : r.error().message);
+  EXPECT_FALSE(r->correction.has_value());
+  ASSERT_FALSE(r->physics->warnings.empty());
+  EXPECT_NE(r->physics->warnings.back().find("geometry correction not applied"), std::string::npos)
+      << r->physics->warnings.back();
+  EXPECT_NE(r->physics->warnings.back().find("quality"), std::string::npos) << r->physics->warnings.back();
+  EXPECT_EQ(r->physics->eigenvalues, plain->physics->eigenvalues);
+  EXPECT_EQ(r->physics->tetMesh.nodes, plain->physics->tetMesh.nodes);
+}
+
 TEST_F(SmallDatabase, ConcurrentQueriesAgreeWithSerialOnes) {
   Database::OpenOptions small;
   small.cacheEntries = 4;
