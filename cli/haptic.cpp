@@ -34,6 +34,7 @@ struct HapticCommandOptions {
   double seconds = 10.0;
   double speed = 0.5;
   bool simulate = false;
+  bool correct = false;
 };
 
 nlohmann::json percentilesJson(const haptics::Percentiles& p) {
@@ -91,7 +92,8 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
             {"stiffness_n_per_m", o.loop.stiffness},
             {"max_force_n", o.loop.maxForce},
             {"workers", o.loop.workers},
-            {"descriptor", o.descriptor}}},
+            {"descriptor", o.descriptor},
+            {"correct", o.correct}}},
           {"objects", std::move(objects)}};
 }
 
@@ -160,6 +162,7 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   query.descriptor = *core::parseDescriptorKind(o.descriptor);
   query.material = *material;
   query.fidelity = false;  // the loop needs the data, not the report; it would double the latency
+  query.correct = o.correct;
   auto loop = haptics::HapticLoop::create(*scene, *device, haptics::databaseAugmenter(*db, query), o.loop);
   if (!loop) {
     printError(loop.error().message);
@@ -255,6 +258,10 @@ Command addHapticCommand(CLI::App& parent) {
       ->capture_default_str()
       ->check(CLI::IsMember({"moment", "voxel", "centroid-voxel"}));
   addMaterialFlags(*app, o->material);
+  app->add_flag("--correct", o->correct,
+                "Augment with the geometry correction (shapedb query --correct): modes of the best entry's\n"
+                "tets morphed onto each object, tens of ms more per object on the augmentation workers,\n"
+                "never in the loop's tick");
   app->add_flag(
       "--simulate", o->simulate,
       "Simulated clock: deterministic, as fast as the machine goes, augmentation served after 20 ms "

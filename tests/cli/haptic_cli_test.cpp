@@ -83,14 +83,19 @@ TEST(HapticCli, ReportParsedBackForASceneWithAnOpenMesh) {
   for (const char* key : {"p50", "p99", "max"})
     EXPECT_GE(r["tick_us"][key].get<double>(), 0.0) << key;
 
-  // The same scene on the steady clock: the structure is the same; the timing is the machine's.
+  EXPECT_EQ(r["options"]["correct"], false);
+
+  // The same scene on the steady clock, augmented with the geometry correction: the structure is the
+  // same; the timing is the machine's.
   const auto steady = dir / "steady.json";
-  run = test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), scene.string(), "--trajectory",
-                                       trajectory.string(), "--seconds", "0.5", "--report", steady.string()});
+  run = test::runProcess(
+      SHAPEDB_CLI, {"haptic", db.string(), scene.string(), "--trajectory", trajectory.string(), "--seconds",
+                    "0.5", "--report", steady.string(), "--correct"});
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("deadline misses"), std::string::npos) << run.out;
   const nlohmann::json s = readJson(steady);
   EXPECT_EQ(s["clock"], "steady");
+  EXPECT_EQ(s["options"]["correct"], true);
   EXPECT_GT(s["ticks"].get<int>(), 0);
   EXPECT_GT(s["achieved_rate_hz"].get<double>(), 0.0);
   EXPECT_GE(s["deadline_misses"].get<int>(), 0);
