@@ -105,12 +105,14 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
                                        " fragments (seed " + std::to_string(o.fracture.seed) +
                                        ", --max-triangles " + std::to_string(o.fracture.maxTriangles) + ")"
                                  : o.queries;
+  char refinement[32];
+  std::snprintf(refinement, sizeof refinement, "%g", o.evaluation.truthRefinement);
   const std::string title =
       "shapedb bench: " + source + ", against " + o.database + " (" + std::to_string(db->entries().size()) +
       " entries, " + volume::toString(db->parameters().entry.modal.order) + " tets), " + material->name +
       "; truth and baselines on " + volume::toString(o.evaluation.directElements) +
-      " tets, the truth's a volume bound " + std::to_string(static_cast<int>(o.evaluation.truthRefinement)) +
-      "x smaller than the entries' and quality bound 1.5";
+      " tets, the truth's with a TetGen volume bound " + refinement +
+      std::string("x smaller than the entries'");
   for (Status st : {io::writeEvaluationCsv(*evaluations, out / "evaluation.csv"),
                     io::writeEvaluationSummary(*evaluations, title, out / "summary.md"),
                     io::writeEvaluationPlots(*evaluations, out)})
@@ -169,7 +171,7 @@ Command addBenchCommand(CLI::App& parent) {
                   "lock in bending and ring high: a poor truth)")
       ->capture_default_str();
   app->add_option("--truth-refinement", o->evaluation.truthRefinement,
-                  "The truth's TetGen volume bound is the entries' divided by this (quality bound 1.5)")
+                  "The truth's TetGen volume bound is the entries' divided by this")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1000.0));
   app->add_option("--truth-max-triangles", o->evaluation.truthMaxTriangles,

@@ -102,7 +102,7 @@ struct EvaluationOptions {
   volume::ElementOrder directElements = volume::ElementOrder::kQuadratic;
   /// The truth is meshed finer than the database's entries, so that its own error is small against the
   /// errors it measures: TetGen's volume bound (volume::entryMeshing of directElements) divided by this,
-  /// and the quality bound 1.5 at most. The baselines are meshed as entries are.
+  /// at the entries' quality bound. The baselines are meshed as entries are.
   double truthRefinement = 8.0;
   /// A shape of more triangles is simplified to about this many (volume::simplify, within 1e-3 of its
   /// size L) before its truth is computed: the tets of a 100k-triangle scan would not fit the memory of a
