@@ -2,7 +2,7 @@
 //   build/release/bin/query_bench [DB] [--queries N] [--csv FILE] [--no-fidelity] [--descriptor KIND]
 //   (DB default: build/demo.db; --no-fidelity: skip the fidelity report, to profile the rest;
 //   --descriptor: moment, voxel or centroid-voxel, the default)
-// Targets on the 2-core reference machine, 5k triangles, against the default 4,500-entry database:
+// Targets on the 2-core reference machine, 5k triangles, against the default database:
 // mass properties + describe + search <= 100 us p50 (the paper: 4 ms); the whole query with physical
 // data fetched, adapted and linked <= 2 ms p50 (fidelity report not included: it is reported apart).
 // Validation (per-face checks, closed surface) is its own stage: it is not part of the first target,

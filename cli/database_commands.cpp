@@ -65,7 +65,7 @@ class ProgressPrinter {
 
 struct BuildCommandOptions {
   std::string path;
-  std::size_t entries = 4500;
+  std::size_t entries = 1800;
   std::string families = "all";
   int modes = 20;
   std::string elements = "quadratic";

@@ -29,7 +29,7 @@ struct BuildParameters {
   /// the surface meshed (docs/accuracy.md); the surface itself is then within 2 % of the smooth one.
   volume::ShapeResolution resolution{.segments = 16, .stacks = 8};
   std::vector<volume::Family> families;  ///< of the generated catalog
-  std::size_t entries = 4500;            ///< size of the generated catalog
+  std::size_t entries = 1800;            ///< size of the generated catalog
 };
 
 /// `parameters` for a database of `order` elements: the entry's elements and TetGen bounds
