@@ -101,6 +101,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mean_boundary_move", c.morph.meanBoundaryMove},
           {"mean_target_distance", c.morph.meanTargetDistance},
           {"projected", c.morph.projected},
+          {"volume_scale", c.volumeScale},
           {"solves", c.solves},
           {"morph_seconds", c.morphSeconds},
           {"modes_seconds", c.modesSeconds}};

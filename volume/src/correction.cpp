@@ -1,5 +1,7 @@
 #include <chrono>
+#include <cmath>
 
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/volume/correction.h>
 
 namespace shapedb::volume {
@@ -20,6 +22,18 @@ Result<CorrectedEntry> correctGeometry(const core::PhysicalData& entry, const co
   if (!morphed) return morphed.error();
   out.report.morph = morphed->report;
   out.physics.tetMesh = std::move(morphed->mesh);
+  // The morphed tets fill the target only as far as the projection went (a boundary node held back off a
+  // sharp edge cuts the corner): scaled about their centre of mass to the target's volume, so that their
+  // modes are those of a body of the query's size and mass, as an entry's are.
+  if (Result<core::MassProperties> targetMass = core::computeMassProperties(target); targetMass) {
+    const core::MassProperties own = core::computeTetMassProperties(out.physics.tetMesh);
+    const double scale = std::cbrt(targetMass->volume / own.volume);
+    if (std::isfinite(scale) && scale > 0.0) {
+      out.report.volumeScale = scale;
+      for (core::Vec3& p : out.physics.tetMesh.nodes)
+        p = own.centerOfMass + scale * (p - own.centerOfMass);
+    }
+  }
   out.physics.massProperties = core::computeTetMassProperties(out.physics.tetMesh);
   out.report.morphSeconds = seconds(start);
 

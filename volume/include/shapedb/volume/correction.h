@@ -19,7 +19,10 @@ struct CorrectionOptions {
 /// What the correction did and what it cost.
 struct CorrectionReport {
   MorphReport morph;  ///< quality, moves, target coverage: in the entry's canonical frame (L = 1)
-  int solves = 0;     ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
+  /// The uniform scale that gave the morphed tets the target's volume (1 where the morph reached all of
+  /// the target; above 1 where held-back boundary nodes cut corners).
+  double volumeScale = 1.0;
+  int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
   double morphSeconds = 0.0;
   double modesSeconds = 0.0;
 };
