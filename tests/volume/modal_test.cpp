@@ -201,15 +201,15 @@ TEST(Modal, SparseLanczosAgreesWithDenseSolverAndModesAreMOrthonormal) {
 // Lanczos started from given vectors (the geometry correction's seeds: an entry's modes on moved nodes)
 // finds the same modes as the dense oracle, whatever the seeds: random ones here, for both orders.
 TEST(Modal, SeededLanczosAgreesWithTheDenseSolverForRandomSeeds) {
-  const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.3, 0.9, 0.6)), {.maxVolumeFraction = 1.0 / 40.0});
+  const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.3, 0.9, 0.6)), {.maxVolumeFraction = 1.0 / 15.0});
   std::mt19937 rng(11);
   std::normal_distribution<double> normal;
   for (ElementOrder order : {ElementOrder::kLinear, ElementOrder::kQuadratic}) {
     const ModalOptions options{.modes = 6, .material = {.poissonRatio = 0.3}, .order = order};
     Result<core::ModalData> dense = computeModesDense(mesh, options);
     ASSERT_TRUE(dense.ok()) << dense.error().message;
-    for (int trial = 0; trial < 3; ++trial) {
-      Eigen::MatrixXd seeds(3 * static_cast<Eigen::Index>(mesh.nodeCount()), 1 + trial * 3);
+    for (int trial = 0; trial < 2; ++trial) {
+      Eigen::MatrixXd seeds(3 * static_cast<Eigen::Index>(mesh.nodeCount()), 1 + trial * 5);
       for (Eigen::Index i = 0; i < seeds.size(); ++i)
         seeds.data()[i] = normal(rng);
       int solves = 0;
