@@ -282,10 +282,10 @@ Command addBuildCommand(CLI::App& parent) {
   app->add_option(
          "--elements", o->elements,
          "Tets of the modal analysis: quadratic (10-node: no locking in bending, so the frequencies of\n"
-         "thin and slender entries are right on coarse meshes, within a median 0.4 % of a mesh three\n"
-         "times finer), or linear (the older databases: constant-strain tets on meshes ~6x finer,\n"
-         "whose frequencies still come out up to 2x too high in bending; the query's --stretch\n"
-         "needs them)")
+         "thin and slender entries are right on coarse meshes, within a median 0.2 % of a mesh three\n"
+         "times finer: docs/accuracy.md), or linear (the older databases: constant-strain tets on\n"
+         "meshes ~6x finer, whose frequencies still come out up to 2x too high in bending; the query's\n"
+         "--stretch needs them)")
       ->capture_default_str();
   app->add_option("--threads", o->threads, "Worker threads (0: all cores)")
       ->capture_default_str()

@@ -16,7 +16,8 @@ namespace shapedb::volume {
 
 /// TetGen's bounds for an entry whose modes use `order` elements. Quadratic tets need much coarser meshes
 /// for the same accuracy, and cost ~10x as much per tet: q3 and 1/100 of the volume (a third of the tet
-/// size gives frequencies a median 0.4 % and at most 4 % lower: docs/accuracy.md), against q1.5 and 1/600
+/// size gives frequencies a median 0.16 % and at most 2 % lower on the entries measured so far:
+/// docs/accuracy.md), against q1.5 and 1/600
 /// for linear ones (whose frequencies still come out high in bending).
 TetrahedralizeOptions entryMeshing(ElementOrder order);
 
