@@ -147,16 +147,23 @@ const char* toString(EvaluationMethod method) {
   return "?";
 }
 
+namespace {
+
+/// The direct computation's time over the query time of the method at `index`.
+double speedupOf(const FragmentEvaluation& e, std::size_t index) {
+  if (e.methods.size() <= index) return MethodEvaluation::kNaN;
+  const double query = e.methods[index].queryMicros;
+  return query > 0.0 ? e.truthSeconds * 1e6 / query : MethodEvaluation::kNaN;
+}
+
+}  // namespace
+
 double FragmentEvaluation::speedup() const {
-  if (methods.size() <= kCentroidVoxelIndex) return MethodEvaluation::kNaN;
-  const double query = methods[kCentroidVoxelIndex].queryMicros;
-  return query > 0.0 ? truthSeconds * 1e6 / query : MethodEvaluation::kNaN;
+  return speedupOf(*this, kCentroidVoxelIndex);
 }
 
 double FragmentEvaluation::correctedSpeedup() const {
-  if (methods.size() <= kCorrectedIndex) return MethodEvaluation::kNaN;
-  const double query = methods[kCorrectedIndex].queryMicros;
-  return query > 0.0 ? truthSeconds * 1e6 / query : MethodEvaluation::kNaN;
+  return speedupOf(*this, kCorrectedIndex);
 }
 
 namespace {

@@ -93,11 +93,14 @@ volume::StageTimes timesFromJson(const json& j) {
 
 }  // namespace
 
+volume::ShapeResolution entryResolution(volume::ElementOrder order) {
+  return order == volume::ElementOrder::kQuadratic ? volume::ShapeResolution{.segments = 16, .stacks = 8}
+                                                   : volume::ShapeResolution{.segments = 24, .stacks = 12};
+}
+
 BuildParameters withElements(BuildParameters parameters, volume::ElementOrder order) {
   parameters.entry = volume::withElements(parameters.entry, order);
-  parameters.resolution = order == volume::ElementOrder::kQuadratic
-                              ? volume::ShapeResolution{.segments = 16, .stacks = 8}
-                              : volume::ShapeResolution{.segments = 24, .stacks = 12};
+  parameters.resolution = entryResolution(order);
   return parameters;
 }
 

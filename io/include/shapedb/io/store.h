@@ -20,21 +20,24 @@ namespace shapedb::io {
 /// The version of the file layout below. A file of another version is refused, never guessed at.
 inline constexpr int kSchemaVersion = 1;
 
+/// The curved families' surface resolution for entries of `order` elements. Quadratic: 16 segments and 8
+/// stacks, which halve the curved entries' tets (and their cost) against 24 and 12 for the same accuracy
+/// of the modes on the surface meshed (docs/accuracy.md); the surface itself is then within 2 % of the
+/// smooth one. Linear: 24 and 12, as databases of linear tets have always been built.
+volume::ShapeResolution entryResolution(volume::ElementOrder order);
+
 /// What a database was built with. Stored in the file; every entry of a file shares them. The defaults
 /// are those of `shapedb build`: quadratic tets (withElements).
 struct BuildParameters {
   volume::EntryOptions entry;
-  /// Surface resolution of the curved families. Quadratic entries: 16 segments and 8 stacks, which halve
-  /// the curved entries' tets (and their cost) against 24 and 12 for the same accuracy of the modes on
-  /// the surface meshed (docs/accuracy.md); the surface itself is then within 2 % of the smooth one.
-  volume::ShapeResolution resolution{.segments = 16, .stacks = 8};
+  /// Surface resolution of the curved families (entryResolution of the entry's elements).
+  volume::ShapeResolution resolution = entryResolution(volume::ElementOrder::kQuadratic);
   std::vector<volume::Family> families;  ///< of the generated catalog
   std::size_t entries = 1800;            ///< size of the generated catalog
 };
 
 /// `parameters` for a database of `order` elements: the entry's elements and TetGen bounds
-/// (volume::withElements) and the surface resolution that goes with them (quadratic: 16 segments and 8
-/// stacks; linear: 24 and 12, as databases of linear tets have always been built).
+/// (volume::withElements) and the surface resolution that goes with them (entryResolution).
 BuildParameters withElements(BuildParameters parameters, volume::ElementOrder order);
 
 /// The parameters as JSON text (stored in the file's meta table), and back.
