@@ -38,7 +38,7 @@ Result<std::vector<io::NamedMesh>> loadShapes(const BenchCommandOptions& o) {
     Result<std::vector<std::filesystem::path>> files = io::listMeshFiles(o.queries);
     if (!files) return files.error();
     for (const std::filesystem::path& file : *files) {
-      Result<io::LoadedMesh> loaded = io::loadMesh(file);
+      Result<io::LoadedMesh> loaded = loadMeshFile(file);
       if (!loaded) return loaded.error();  // names the file
       shapes.push_back({file.stem().string(), file.string(), std::move(loaded->mesh)});
     }

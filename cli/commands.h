@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include <shapedb/core/result.h>
+#include <shapedb/io/mesh_io.h>
 #include <shapedb/volume/fracture.h>
 
 namespace shapedb::cli {
@@ -45,5 +46,9 @@ void addFractureFlags(CLI::App& app, volume::FractureOptions& options);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);
+
+/// io::loadMesh, and what it did to the file's mesh (a surface wound inward, flipped) printed on stderr
+/// as "shapedb: warning: <file>: <note>". Every command that reads a mesh file reads it through this.
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const io::LoadOptions& options = {});
 
 }  // namespace shapedb::cli

@@ -240,7 +240,7 @@ struct AddOptions {
 int runAdd(const AddOptions& o) {
   std::vector<io::NamedMesh> meshes;
   for (const std::string& file : o.meshes) {
-    auto loaded = io::loadMesh(file);
+    auto loaded = loadMeshFile(file);
     if (!loaded) {
       printError(loaded.error().message);
       return kExitInputError;

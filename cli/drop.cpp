@@ -91,7 +91,7 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
     }
   } else {
     for (const std::string& file : o.meshes) {
-      Result<io::LoadedMesh> loaded = io::loadMesh(file);
+      Result<io::LoadedMesh> loaded = loadMeshFile(file);
       if (!loaded) {
         printError(loaded.error().message);
         return kExitInputError;

@@ -65,7 +65,7 @@ nlohmann::json reportJson(const InspectOptions& options, const io::LoadedMesh& l
             {"plane_symmetry", n.planeSymmetry},
             {"distinct_axis_ambiguous", n.distinctAxisAmbiguous}}},
           {"approximate", mp.isApproximate},
-          {"flipped", mp.wasFlipped}};
+          {"flipped", mp.wasFlipped || loaded.flippedInsideOut}};
 }
 
 void printText(const InspectOptions& options, const io::LoadedMesh& loaded, const core::MassProperties& mp,
@@ -81,7 +81,8 @@ void printText(const InspectOptions& options, const io::LoadedMesh& loaded, cons
               t.boundaryEdges, t.nonManifoldEdges, t.inconsistentEdges, loaded.defects.zeroAreaFaces);
   if (mp.isApproximate)
     std::printf("APPROXIMATE: vertex point masses (paper §4.1); the surface does not bound a solid\n");
-  if (mp.wasFlipped) std::printf("note: the mesh was inside out and has been flipped\n");
+  if (mp.wasFlipped || loaded.flippedInsideOut)
+    std::printf("note: the mesh was inside out and has been flipped\n");
   std::printf("volume           %.9g m³\n", mp.volume);
   std::printf("area             %.9g m²\n", mp.area);
   std::printf("density          %.9g kg/m³, mass %.9g kg\n", mp.density, mp.mass);

@@ -17,7 +17,7 @@ void addMeshInputFlags(CLI::App& app, MeshInputOptions& options) {
 }
 
 std::optional<MeshInput> loadMeshInput(const std::string& path, const MeshInputOptions& options) {
-  Result<io::LoadedMesh> loaded = io::loadMesh(path, {.allowDegenerateFaces = options.allowDegenerate});
+  Result<io::LoadedMesh> loaded = loadMeshFile(path, {.allowDegenerateFaces = options.allowDegenerate});
   if (!loaded) {
     printError(loaded.error().message);
     return std::nullopt;

@@ -272,7 +272,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   if (o.table && !o.json) printTableHeader();
   for (std::size_t i = 0; i < o.meshes.size(); ++i) {
     const std::string& file = o.meshes[i];
-    auto loaded = io::loadMesh(file);
+    auto loaded = loadMeshFile(file);
     if (!loaded) {
       printError(loaded.error().message);
       status = kExitInputError;
@@ -297,6 +297,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
     if (o.json) {
       nlohmann::json q = {{"file", file},
                           {"triangles", loaded->mesh.triangleCount()},
+                          {"flipped_inside_out", loaded->flippedInsideOut},
                           {"volume", result->massProperties.volume},
                           {"size", std::cbrt(result->massProperties.volume)},
                           {"descriptor", o.descriptor},

@@ -45,7 +45,7 @@ std::vector<core::Vec3> vertexNormals(const core::TriangleMesh& mesh) {
 int runSound(const SoundCommandOptions& o, const CLI::App& app) {
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
-  Result<io::LoadedMesh> loaded = io::loadMesh(o.mesh);
+  Result<io::LoadedMesh> loaded = loadMeshFile(o.mesh);
   if (!loaded) {
     printError(loaded.error().message);
     return kExitInputError;

@@ -2,6 +2,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <mutex>
@@ -110,6 +111,16 @@ Result<detail::RawPolygons> readStl(const std::filesystem::path& path) {
   return std::move(importer.raw);
 }
 
+/// Signed volume of a closed surface (divergence theorem), about its first vertex so that a mesh far from
+/// the origin loses no digits.
+double signedVolume(const core::TriangleMesh& mesh) {
+  const core::Vec3 o = mesh.vertices.front();
+  double six = 0.0;
+  for (const auto& t : mesh.triangles)
+    six += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
+  return six / 6.0;
+}
+
 // OpenMesh's writers need one of its own kernels; double-precision points so nothing is lost before
 // the writer formats them.
 struct DoubleTraits : OpenMesh::DefaultTraits {
@@ -185,6 +196,26 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
       return fileError(path, ErrorCode::kEmptyMesh, "mesh has no faces once degenerate faces are dropped");
   }
   out.topology = core::analyzeTopology(out.mesh);
+  if (out.topology.isClosed() && out.topology.isConsistentlyOriented()) {
+    out.signedVolumeAsRead = signedVolume(out.mesh);
+    if (options.orientOutward && out.signedVolumeAsRead < 0.0) {
+      for (auto& t : out.mesh.triangles)
+        std::swap(t[1], t[2]);
+      out.flippedInsideOut = true;
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> LoadedMesh::notes() const {
+  std::vector<std::string> out;
+  if (flippedInsideOut) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the surface is wound inward (signed volume %.6g m³) and has been flipped",
+                  signedVolumeAsRead);
+    out.emplace_back(text);
+  }
   return out;
 }
 

@@ -245,6 +245,40 @@ TEST(MeshIo, DegenerateFacesAreAcceptedOnlyWhenAsked) {
   EXPECT_TRUE(loaded.topology.isClosed());
 }
 
+TEST(MeshIo, ASurfaceWoundInwardIsFlippedAtLoadAndSaysSo) {
+  test::ScratchDir dir("mesh-io-flip");
+  const TriangleMesh box = core::makeBox({0.3, 0.2, 0.1});
+  TriangleMesh inward = box;
+  for (auto& t : inward.triangles)
+    std::swap(t[1], t[2]);
+  // Far from the origin, as scans are: the sign must not drown in the coordinates' digits.
+  for (Vec3& p : inward.vertices)
+    p += Vec3(4.0e5, -3.0e5, 2.0e5);
+  test::writeFile(dir / "inward.obj", test::objText(inward));
+
+  const LoadedMesh loaded = mustLoad(dir / "inward.obj");
+  EXPECT_TRUE(loaded.flippedInsideOut);
+  EXPECT_NEAR(loaded.signedVolumeAsRead, -0.006, 1e-9);
+  EXPECT_NEAR(volumeOf(loaded.mesh), 0.006, 1e-9);
+  ASSERT_EQ(loaded.notes().size(), 1u);
+  EXPECT_NE(loaded.notes().front().find("wound inward"), std::string::npos);
+
+  const LoadedMesh asIs = mustLoad(dir / "inward.obj", {.orientOutward = false});
+  EXPECT_FALSE(asIs.flippedInsideOut);
+  EXPECT_EQ(asIs.mesh.triangles, inward.triangles);
+
+  // Outward already: untouched, nothing to say. One face reversed: no flip can fix it, so none is made.
+  test::writeFile(dir / "outward.obj", test::objText(box));
+  EXPECT_FALSE(mustLoad(dir / "outward.obj").flippedInsideOut);
+  EXPECT_TRUE(mustLoad(dir / "outward.obj").notes().empty());
+  TriangleMesh oneFace = box;
+  std::swap(oneFace.triangles[0][1], oneFace.triangles[0][2]);
+  test::writeFile(dir / "one_face.obj", test::objText(oneFace));
+  const LoadedMesh inconsistent = mustLoad(dir / "one_face.obj");
+  EXPECT_FALSE(inconsistent.flippedInsideOut);
+  EXPECT_EQ(inconsistent.mesh.triangles, oneFace.triangles);
+}
+
 TEST(MeshIo, SaveRejectsUnknownFormatsAndInvalidMeshes) {
   test::ScratchDir dir("io");
   const TriangleMesh box = core::makeBox({1, 1, 1});

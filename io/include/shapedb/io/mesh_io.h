@@ -15,6 +15,10 @@ struct LoadOptions {
   /// Keep degenerate faces instead of failing: faces with a repeated vertex are dropped (and counted),
   /// zero-area faces with distinct vertices are kept (they contribute nothing to areas or volumes).
   bool allowDegenerateFaces = false;
+  /// A closed, consistently oriented surface that encloses a negative volume (wound inward, as some
+  /// exporters write) is flipped, and LoadedMesh::flippedInsideOut says so. An inconsistently oriented
+  /// one is left as it is: no flip can fix it, and the stages that need a solid refuse it.
+  bool orientOutward = true;
 };
 
 /// A mesh read from a file, with what was learnt about it on the way in. Plain value type.
@@ -25,6 +29,12 @@ struct LoadedMesh {
   std::string format;                    ///< "obj", "ply", "off" or "stl"
   std::size_t polygonsTriangulated = 0;  ///< faces with more than three vertices, fan-triangulated
   std::size_t facesDropped = 0;          ///< repeated-vertex faces dropped under allowDegenerateFaces
+  bool flippedInsideOut = false;         ///< wound inward as read, flipped (LoadOptions::orientOutward)
+  double signedVolumeAsRead = 0.0;       ///< of a closed, consistent surface as read (m³), else 0
+
+  /// What a user should hear about the file's mesh ("the surface was wound inward ... flipped"), one
+  /// sentence each; empty when it was read as it is.
+  std::vector<std::string> notes() const;
 };
 
 /// Reads an OBJ, PLY (ASCII or binary), OFF or STL (ASCII or binary) file, chosen by extension
