@@ -44,13 +44,23 @@ int runFracture(const FractureCommandOptions& o) {
     }
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("%s: %zu fragments from %d seeds (seed %llu, voxel %.4g m) in %.2f s, written to %s\n",
-              o.mesh.c_str(), pieces->fragments.size(), o.fracture.pieces,
-              static_cast<unsigned long long>(o.fracture.seed), pieces->voxelSize, seconds, o.out.c_str());
-  if (pieces->crumbsDropped + pieces->openDropped > 0)
-    std::printf(
-        "dropped: %zu crumb(s) under %.3g of the volume, %zu fragment(s) whose surface did not close\n",
-        pieces->crumbsDropped, o.fracture.minVolumeFraction, pieces->openDropped);
+  std::printf(
+      "%s: %zu fragments from %d seeds (seed %llu, resolution %d, voxel %.4g m) in %.2f s, written to %s\n",
+      o.mesh.c_str(), pieces->fragments.size(), o.fracture.pieces,
+      static_cast<unsigned long long>(o.fracture.seed), pieces->resolution, pieces->voxelSize, seconds,
+      o.out.c_str());
+  std::printf("volume kept: %.2f %% of the solid's (%.4g of %.4g m3)", 100.0 * pieces->keptFraction(),
+              pieces->keptVolume, pieces->solidVolume);
+  if (pieces->crumbsDropped > 0)
+    std::printf("; %zu crumb(s) under %.3g of the volume dropped", pieces->crumbsDropped,
+                o.fracture.minVolumeFraction);
+  if (pieces->openDropped > 0)
+    std::printf("; %zu fragment(s) with no closed surface dropped", pieces->openDropped);
+  if (pieces->droppedVolume > 0.0)
+    std::printf(" (%.3g %% of the volume)", 100.0 * pieces->droppedVolume / pieces->solidVolume);
+  if (pieces->remeshed > 0)
+    std::printf("; %zu fragment(s) meshed slightly off the zero level to close", pieces->remeshed);
+  std::printf("\n");
   return kExitOk;
 }
 
@@ -58,7 +68,7 @@ int runFracture(const FractureCommandOptions& o) {
 
 Result<volume::FractureResult> fractureMeshFile(const std::string& path,
                                                 const volume::FractureOptions& options) {
-  Result<io::LoadedMesh> loaded = io::loadMesh(path);
+  Result<io::LoadedMesh> loaded = loadMeshFile(path);
   if (!loaded) return loaded.error();
   Result<volume::FractureResult> pieces = volume::fracture(loaded->mesh, options);
   if (!pieces) return withContext(pieces.error(), path);
@@ -68,8 +78,10 @@ Result<volume::FractureResult> fractureMeshFile(const std::string& path,
 void addFractureFlags(CLI::App& app, volume::FractureOptions& options) {
   app.add_option("--seed", options.seed, "Random seed: the same seed gives the same fragments")
       ->capture_default_str();
-  app.add_option("--resolution", options.resolution, "Level-set voxels along the mesh's longest side")
-      ->capture_default_str()
+  app.add_option("--resolution", options.resolution,
+                 "Level-set voxels along the mesh's longest side, 16 to 1,024 [default: automatic, 128 or\n"
+                 "more where the solid or its pieces would be thin in voxels: at least 6 across its mean\n"
+                 "thickness and 16 across a fragment, so that the cuts keep the volume]")
       ->check(CLI::Range(16, 1024));
   app.add_option("--max-triangles", options.maxTriangles,
                  "Simplify each fragment to this many triangles, as far as moving its surface by at most a\n"
@@ -86,7 +98,7 @@ Command addFractureCommand(CLI::App& parent) {
       "random seeds inside it define Voronoi cells, and each cell's level set is intersected with it (a\n"
       "cell that cuts a non-convex solid in two gives two fragments). Fragments are closed meshes in the\n"
       "mesh's frame, largest first, with voxel-scale detail on the cuts; crumbs under 1e-4 of the volume\n"
-      "are dropped. Deterministic per seed. 200 pieces of a plate take about 2 s at the default resolution.");
+      "are dropped. Deterministic per seed. 200 pieces of a plate take about 2 s.");
   app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl)")->required();
   app->add_option("--pieces", o->fracture.pieces, "Voronoi seeds (fragments, give or take)")
       ->required()

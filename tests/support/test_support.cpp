@@ -1,6 +1,8 @@
 #include "support/test_support.h"
 
 #include <atomic>
+#include <cctype>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -50,6 +52,27 @@ ScratchDir::~ScratchDir() {
 void writeFile(const std::filesystem::path& path, const std::string& content) {
   std::ofstream out(path, std::ios::binary);
   out.write(content.data(), static_cast<std::streamsize>(content.size()));
+}
+
+std::optional<std::filesystem::path> realMeshDirectory(std::string* why) {
+  namespace fs = std::filesystem;
+  const char* fromEnvironment = std::getenv("SHAPEDB_REAL_MESHES");
+  const fs::path folder = fromEnvironment != nullptr && *fromEnvironment != '\0'
+                              ? fs::path(fromEnvironment)
+                              : fs::path(SHAPEDB_REAL_MESHES_DEFAULT);
+  std::error_code ec;
+  if (fs::is_directory(folder, ec))
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(folder, ec)) {
+      std::string extension = entry.path().extension().string();
+      for (char& c : extension)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (extension == ".obj" || extension == ".ply" || extension == ".stl" || extension == ".off")
+        return fs::weakly_canonical(folder, ec);
+    }
+  if (why != nullptr)
+    *why = "no real meshes in " + folder.string() +
+           " (set SHAPEDB_REAL_MESHES, or the CMake cache variable of that name, to a folder of meshes)";
+  return std::nullopt;
 }
 
 std::string readFile(const std::filesystem::path& path) {

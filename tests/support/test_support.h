@@ -3,6 +3,7 @@
 // Helpers shared by the test suites: seeded random transforms, scratch directories, mesh comparisons.
 
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -37,6 +38,17 @@ class ScratchDir {
  private:
   std::filesystem::path mPath;
 };
+
+/// The folder of real meshes ($SHAPEDB_REAL_MESHES, else the build's SHAPEDB_REAL_MESHES), or nothing when
+/// it holds no mesh file; `why` then says where it looked.
+std::optional<std::filesystem::path> realMeshDirectory(std::string* why = nullptr);
+
+/// In a test body: the real-mesh folder into `var`, or the test skipped with the reason.
+#define SHAPEDB_REAL_MESHES_OR_SKIP(var)                                                                 \
+  std::string var##Why;                                                                                  \
+  const std::optional<std::filesystem::path> var##Found = ::shapedb::test::realMeshDirectory(&var##Why); \
+  if (!var##Found) GTEST_SKIP() << var##Why;                                                             \
+  const std::filesystem::path var = *var##Found
 
 /// Writes `content` to `path` byte for byte.
 void writeFile(const std::filesystem::path& path, const std::string& content);

@@ -1,5 +1,7 @@
 // Fracture: closed fragments that fill the solid, the same ones for the same seed, clear errors.
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include <shapedb/core/mass_properties.h>
@@ -10,6 +12,8 @@
 
 namespace shapedb::volume {
 namespace {
+
+using core::Vec3;
 
 double volumeOf(const core::TriangleMesh& mesh) {
   auto mp = core::computeMassProperties(mesh);
@@ -50,7 +54,62 @@ TEST(Fracture, FragmentsAreClosedSolidsThatFillThePlateAndSphere) {
     // this resolution, that is 6 %; the fragments never add volume.
     EXPECT_GT(total / solid, 0.9);
     EXPECT_LT(total / solid, 1.005);
+    EXPECT_NEAR(r->keptVolume, total, 1e-9 * solid);
+    EXPECT_NEAR(r->solidVolume, solid, 1e-9 * solid);
   }
+}
+
+TEST(Fracture, AMeshFarFromTheOriginBreaksAsAtTheOrigin) {
+  // Scans and CAD exports sit hundreds of metres (or kilometres) from the origin: single-precision level
+  // sets there tore fragments open and dropped them. Up to the offset, the fragments are the same.
+  const core::TriangleMesh pebble = core::transformed(core::makeIcosphere(0.05, 3), [] {
+    core::Mat4 m = core::Mat4::Identity();
+    m.diagonal().head<3>() = Vec3(1.6, 1.0, 0.7);
+    return m;
+  }());
+  FractureOptions options;
+  options.pieces = 12;
+  options.seed = 5;
+  options.resolution = 64;
+  const Result<FractureResult> here = fracture(pebble, options);
+  ASSERT_TRUE(here.ok()) << here.error().message;
+  EXPECT_EQ(here->openDropped, 0u);
+  EXPECT_EQ(here->resolution, 64);  // as given
+  for (const double offset : {1e3, 1e6}) {
+    SCOPED_TRACE(offset);
+    const Vec3 shift(offset, -0.7 * offset, 0.3 * offset);
+    core::TriangleMesh far = pebble;
+    for (Vec3& p : far.vertices)
+      p += shift;
+    const Result<FractureResult> there = fracture(far, options);
+    ASSERT_TRUE(there.ok()) << there.error().message;
+    EXPECT_EQ(there->openDropped, 0u);
+    EXPECT_NEAR(there->keptFraction(), here->keptFraction(), 1e-6);
+    ASSERT_EQ(there->fragments.size(), here->fragments.size());
+    for (std::size_t i = 0; i < here->fragments.size(); ++i) {
+      const core::MassProperties a = *core::computeMassProperties(here->fragments[i]);
+      const core::MassProperties b = *core::computeMassProperties(there->fragments[i]);
+      EXPECT_NEAR(b.volume / a.volume, 1.0, 1e-5) << i;
+      EXPECT_LT((b.centerOfMass - shift - a.centerOfMass).norm(), 1e-3 * here->voxelSize) << i;
+    }
+  }
+}
+
+TEST(Fracture, TheAutomaticResolutionResolvesThinSolidsAndSmallPieces) {
+  const core::TriangleMesh pebble = core::makeIcosphere(0.05, 3);
+  EXPECT_EQ(automaticResolution(pebble, 20), 128);  // 128 voxels already put 16 across each piece
+  // In 1,000 pieces: 16 voxels across a piece's (V/1000)^(1/3).
+  const int many = automaticResolution(pebble, 1000);
+  const double piece = std::cbrt(volumeOf(pebble) / 1000.0);
+  const double longest = (core::computeBounds(pebble).max - core::computeBounds(pebble).min).maxCoeff();
+  EXPECT_GT(many, 128);
+  EXPECT_NEAR(longest / many, piece / 16.0, longest / many * 0.01);
+  // A plate 3 mm thick and 0.36 m wide: 6 voxels across its thickness (2V/A, just under 3 mm).
+  const core::TriangleMesh tray = core::makeBox({0.36, 0.36, 0.003});
+  const int thin = automaticResolution(tray, 50);
+  EXPECT_GE(0.36 / thin * 6.0, 0.0029);
+  EXPECT_LE(0.36 / thin * 6.0, 0.003);
+  EXPECT_EQ(automaticResolution(core::makeBox({1.0, 1.0, 1e-4}), 10), 1024);  // at most 1,024
 }
 
 TEST(Fracture, TheSameSeedGivesTheSameFragmentsAndAnotherSeedOthers) {

@@ -13,6 +13,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/fracture.h>
 #include <shapedb/volume/openvdb_runtime.h>
@@ -27,7 +28,8 @@ using core::Vec3;
 
 namespace {
 
-constexpr float kHalfWidth = 3.0f;  ///< narrow band, voxels, for the solid and every cutter alike
+constexpr float kHalfWidth = 3.0f;     ///< narrow band, voxels, for the solid and every cutter alike
+constexpr double kFrameMargin = 16.0;  ///< voxels between the local frame's origin and the mesh's bounds
 
 openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::Transform& transform) {
   std::vector<openvdb::Vec3s> points;
@@ -41,20 +43,24 @@ openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::
   return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(transform, points, triangles, kHalfWidth);
 }
 
-/// Signed volume of a closed surface (divergence theorem).
+/// Signed volume of a closed surface (divergence theorem), about its first vertex: about the origin, a
+/// mesh a kilometre away would lose every digit of it.
 double signedVolume(const TriangleMesh& mesh) {
+  if (mesh.vertices.empty()) return 0.0;
+  const Vec3 o = mesh.vertices.front();
   double six = 0.0;
   for (const auto& t : mesh.triangles)
-    six += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
+    six += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
   return six / 6.0;
 }
 
-/// The zero crossing of a fragment's level set, as an outward-wound triangle mesh (quads split).
-TriangleMesh meshOf(const openvdb::FloatGrid& grid) {
+/// The crossing of a fragment's level set at `isovalue` (m), as an outward-wound triangle mesh (quads
+/// split).
+TriangleMesh meshOf(const openvdb::FloatGrid& grid, double isovalue) {
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(grid, points, triangles, quads, 0.0, 0.0);
+  openvdb::tools::volumeToMesh(grid, points, triangles, quads, isovalue, 0.0);
   TriangleMesh mesh;
   mesh.vertices.reserve(points.size());
   for (const openvdb::Vec3s& p : points)
@@ -71,15 +77,95 @@ TriangleMesh meshOf(const openvdb::FloatGrid& grid) {
   return mesh;
 }
 
+bool closedSolid(const TriangleMesh& mesh) {
+  return !mesh.triangles.empty() && core::validateMesh(mesh).ok() &&
+         core::requireClosedOriented(core::analyzeTopology(mesh)).ok();
+}
+
+/// How a fragment's surface came out of its level set.
+enum class Meshing { kClosed, kRemeshed, kOpen };
+
+/// A fragment's closed surface: the zero crossing, simplified. Marching cubes can leave a non-manifold
+/// edge or vertex where two sheets of the level set touch within a voxel (a thin wall, a cut grazing a
+/// surface); a crossing slightly inside or outside the zero level separates them, so those are tried
+/// next, a hundredth of a voxel at a time (the surface moves by that much, far under the simplification's
+/// own error). A simplification that does not stay closed is not used.
+std::pair<TriangleMesh, Meshing> fragmentSurface(const openvdb::FloatGrid& grid, double voxelSize,
+                                                 const FractureOptions& options) {
+  static constexpr double kIsovalues[] = {0.0, -0.01, 0.01, -0.03, 0.03, -0.1, 0.1};
+  TriangleMesh raw;
+  Meshing meshing = Meshing::kOpen;
+  for (const double isovalue : kIsovalues) {
+    raw = meshOf(grid, isovalue * voxelSize);
+    if (raw.triangles.empty() || closedSolid(raw)) {
+      meshing = isovalue == 0.0 ? Meshing::kClosed : Meshing::kRemeshed;
+      break;
+    }
+  }
+  if (meshing == Meshing::kOpen) return {meshOf(grid, 0.0), meshing};
+  if (options.maxTriangles == 0 || raw.triangles.size() <= options.maxTriangles)
+    return {std::move(raw), meshing};
+  // Simplified about the fragment's own centre (the decimater's quadrics are computed in coordinates).
+  // Its quadric bound holds each collapse near the planes it has merged, not the faces it leaves: on thin
+  // plates whole strips of a fragment's rim came out bevelled several times the bound deep, and a few per
+  // cent of its volume gone. So every simplified face is checked at its centroid against the raw surface;
+  // one farther than twice the bound has the simplification done again with half the error, and at the
+  // end the raw surface stands.
+  const core::Bounds box = core::computeBounds(raw);
+  const Vec3 centre = 0.5 * (box.min + box.max);
+  TriangleMesh centred = raw;
+  for (Vec3& p : centred.vertices)
+    p -= centre;
+  const core::ClosestPointTree rawSurface(centred);
+  const auto faithful = [&](const TriangleMesh& simpler, double maxError) {
+    const double limitSq = 4.0 * maxError * maxError;
+    for (const auto& t : simpler.triangles) {
+      const Vec3 c = (simpler.vertices[t[0]] + simpler.vertices[t[1]] + simpler.vertices[t[2]]) / 3.0;
+      if (rawSurface.closest(c).closest.squaredDistance > limitSq) return false;
+    }
+    return true;
+  };
+  SimplifyOptions simplifyOptions;
+  simplifyOptions.maxTriangles = options.maxTriangles;
+  for (double error = options.simplifyError; error >= options.simplifyError / 4.0; error /= 2.0) {
+    simplifyOptions.maxError = error * voxelSize;
+    Result<TriangleMesh> simpler = simplify(centred, simplifyOptions);
+    if (!simpler.ok() || !closedSolid(*simpler)) break;
+    if (!faithful(*simpler, simplifyOptions.maxError)) continue;
+    for (Vec3& p : simpler->vertices)
+      p += centre;
+    return {std::move(simpler).value(), meshing};
+  }
+  return {std::move(raw), meshing};
+}
+
 }  // namespace
+
+int automaticResolution(const TriangleMesh& mesh, int pieces) {
+  constexpr double kBase = 128.0, kMax = 1024.0, kAcrossThickness = 6.0, kAcrossFragment = 16.0;
+  const core::Bounds bounds = core::computeBounds(mesh);
+  const double longest = (bounds.max - bounds.min).maxCoeff();
+  const double volume = std::abs(signedVolume(mesh));
+  double area = 0.0;
+  for (const auto& t : mesh.triangles)
+    area +=
+        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm();
+  area *= 0.5;
+  if (!(longest > 0.0 && volume > 0.0 && area > 0.0)) return static_cast<int>(kBase);
+  const double thickness = 2.0 * volume / area;
+  const double fragment = std::cbrt(volume / std::max(pieces, 1));
+  const double voxel = std::min({longest / kBase, thickness / kAcrossThickness, fragment / kAcrossFragment});
+  return static_cast<int>(std::min(kMax, std::ceil(longest / voxel)));
+}
 
 Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions& options) {
   if (options.pieces < 1 || options.pieces > 1000)
     return Error{ErrorCode::kInvalidArgument,
                  "pieces must be 1 to 1,000, not " + std::to_string(options.pieces)};
-  if (options.resolution < 16 || options.resolution > 1024)
-    return Error{ErrorCode::kInvalidArgument,
-                 "resolution must be 16 to 1,024 voxels, not " + std::to_string(options.resolution)};
+  if (options.resolution != 0 && (options.resolution < 16 || options.resolution > 1024))
+    return Error{
+        ErrorCode::kInvalidArgument,
+        "resolution must be 16 to 1,024 voxels (or 0: automatic), not " + std::to_string(options.resolution)};
   if (options.maxTriangles != 0 && (options.maxTriangles < 100 || !(options.simplifyError > 0.0)))
     return Error{ErrorCode::kInvalidArgument,
                  "fragments simplified to fewer than 100 triangles, or with no error allowed, would not "
@@ -93,13 +179,27 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
     return Error{ErrorCode::kInsideOut,
                  "the surface encloses a negative or zero volume (faces wound inward?)"};
 
+  // Everything below happens in a local frame in double precision until OpenVDB's single-precision
+  // points: scans and CAD exports often sit hundreds of metres from the origin, where a float cannot
+  // resolve a voxel's hundredth and the level sets' surfaces tear. The frame puts the mesh's bounds a few
+  // voxels into the positive octant, so that the solid also lies within one of the grid tree's top-level
+  // nodes (a solid straddling the origin, where all of them meet, came out of the CSG with a hole along
+  // the coordinate planes).
   initializeOpenVdb();
-  const core::Bounds bounds = core::computeBounds(mesh);
+  const core::Bounds worldBounds = core::computeBounds(mesh);
   FractureResult result;
-  result.voxelSize = (bounds.max - bounds.min).maxCoeff() / options.resolution;
+  result.solidVolume = volume;
+  result.resolution =
+      options.resolution != 0 ? options.resolution : automaticResolution(mesh, options.pieces);
+  result.voxelSize = (worldBounds.max - worldBounds.min).maxCoeff() / result.resolution;
+  const Vec3 origin = worldBounds.min - Vec3::Constant(kFrameMargin * result.voxelSize);
+  TriangleMesh local = mesh;
+  for (Vec3& p : local.vertices)
+    p -= origin;
+  const core::Bounds bounds = core::computeBounds(local);
   const openvdb::math::Transform::Ptr transform =
       openvdb::math::Transform::createLinearTransform(result.voxelSize);
-  openvdb::FloatGrid::Ptr solid = levelSet(mesh, *transform);
+  openvdb::FloatGrid::Ptr solid = levelSet(local, *transform);
 
   // Seeds: uniform in the bounding box, kept where the level set says the point is inside.
   std::mt19937_64 rng(options.seed);
@@ -133,10 +233,10 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
       const TriangleMesh cutterMesh = detail::triangulate(cell);
       const core::Bounds cellBounds = core::computeBounds(cutterMesh);
       const Vec3 lo = cellBounds.min - margin, hi = cellBounds.max + margin;
-      const openvdb::FloatGrid::Ptr local =
+      const openvdb::FloatGrid::Ptr clipped =
           openvdb::tools::clip(*solid, openvdb::BBoxd({lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}));
       const openvdb::FloatGrid::Ptr cutter = levelSet(cutterMesh, *transform);
-      const openvdb::FloatGrid::Ptr piece = openvdb::tools::csgIntersectionCopy(*local, *cutter);
+      const openvdb::FloatGrid::Ptr piece = openvdb::tools::csgIntersectionCopy(*clipped, *cutter);
       if (piece->tree().empty()) continue;
       openvdb::tools::segmentSDF(*piece, cellGrids[i]);
     }
@@ -145,30 +245,30 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   for (auto& g : cellGrids)
     grids.insert(grids.end(), g.begin(), g.end());
 
-  // Meshed, and simplified where the raw mesh is closed (an open one is dropped below either way).
-  std::vector<TriangleMesh> meshes(grids.size());
+  std::vector<std::pair<TriangleMesh, Meshing>> surfaces(grids.size());
   tbb::parallel_for(std::size_t{0}, grids.size(), [&](std::size_t i) {
-    meshes[i] = meshOf(*grids[i]);
-    if (options.maxTriangles == 0 || meshes[i].triangles.size() <= options.maxTriangles) return;
-    SimplifyOptions simplifyOptions;
-    simplifyOptions.maxTriangles = options.maxTriangles;
-    simplifyOptions.maxError = options.simplifyError * result.voxelSize;
-    if (Result<TriangleMesh> simpler = simplify(meshes[i], simplifyOptions); simpler.ok())
-      meshes[i] = std::move(simpler).value();
+    surfaces[i] = fragmentSurface(*grids[i], result.voxelSize, options);
   });
 
   std::vector<std::pair<double, TriangleMesh>> pieces;
-  for (TriangleMesh& piece : meshes) {
+  for (auto& [piece, meshing] : surfaces) {
     if (piece.triangles.empty()) continue;
     const double v = signedVolume(piece);
+    if (meshing == Meshing::kOpen) {
+      // No crossing near the zero level closed: never seen, and not passed on as a solid.
+      ++result.openDropped;
+      result.droppedVolume += std::max(v, 0.0);
+      continue;
+    }
     if (v < options.minVolumeFraction * volume) {
       ++result.crumbsDropped;
+      result.droppedVolume += std::max(v, 0.0);
       continue;
     }
-    if (!core::validateMesh(piece).ok() || !core::requireClosedOriented(core::analyzeTopology(piece)).ok()) {
-      ++result.openDropped;
-      continue;
-    }
+    if (meshing == Meshing::kRemeshed) ++result.remeshed;
+    result.keptVolume += v;
+    for (Vec3& p : piece.vertices)
+      p += origin;
     pieces.emplace_back(v, std::move(piece));
   }
   // Largest first; ties (never in practice) by the first vertex, so the order is the mesh's own.
