@@ -1,0 +1,88 @@
+// Welding: the hash-grid weld against the every-pair oracle, and a soup that becomes a closed surface.
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/core/topology.h>
+#include <shapedb/core/weld.h>
+
+namespace shapedb::core {
+namespace {
+
+/// Every triangle with its own three corners, as STL files hold surfaces.
+TriangleMesh soupOf(const TriangleMesh& mesh) {
+  TriangleMesh soup;
+  for (const auto& t : mesh.triangles) {
+    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
+    for (const std::uint32_t v : t)
+      soup.vertices.push_back(mesh.vertices[v]);
+    soup.triangles.push_back({base, base + 1, base + 2});
+  }
+  return soup;
+}
+
+TEST(Weld, ASoupOfAClosedSurfaceBecomesThatSurface) {
+  const TriangleMesh box = makeBox({0.3, 0.2, 0.1});
+  TriangleMesh soup = soupOf(box);
+  ASSERT_FALSE(analyzeTopology(soup).isClosed());
+  const WeldReport report = weldVertices(soup);
+  EXPECT_EQ(soup.vertices.size(), box.vertices.size());
+  EXPECT_EQ(soup.triangles.size(), box.triangles.size());
+  EXPECT_EQ(report.verticesMerged, 3 * box.triangles.size() - box.vertices.size());
+  EXPECT_EQ(report.facesCollapsed, 0u);
+  const TopologyReport topology = analyzeTopology(soup);
+  EXPECT_TRUE(topology.isClosed());
+  EXPECT_TRUE(topology.isConsistentlyOriented());
+}
+
+TEST(Weld, WithinAToleranceNearbyCornersMergeAndSliversGo) {
+  TriangleMesh soup = soupOf(makeBox({0.3, 0.2, 0.1}));
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> jitter(-1e-7, 1e-7);
+  for (Vec3& p : soup.vertices)
+    p += Vec3(jitter(rng), jitter(rng), jitter(rng));
+  TriangleMesh exact = soup;
+  EXPECT_EQ(weldVertices(exact).verticesMerged, 0u);  // nothing is exactly equal any more
+  weldVertices(soup, 1e-6);
+  EXPECT_TRUE(analyzeTopology(soup).isClosed());
+  EXPECT_EQ(soup.vertices.size(), 8u);
+}
+
+TEST(Weld, TheHashGridAgreesWithEveryPairOnRandomClusters) {
+  std::mt19937_64 rng(2026);
+  for (int trial = 0; trial < 40; ++trial) {
+    SCOPED_TRACE(trial);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const double tolerance = trial % 4 == 0 ? 0.0 : std::pow(10.0, -1.0 - trial % 3);
+    // Clusters of points around random centres, some within the tolerance of each other and some not,
+    // with exact duplicates, on and around cell boundaries.
+    TriangleMesh mesh;
+    std::vector<Vec3> centres(30);
+    for (Vec3& c : centres)
+      c = Vec3(unit(rng), unit(rng), unit(rng));
+    std::uniform_int_distribution<std::size_t> pick(0, centres.size() - 1);
+    for (int i = 0; i < 300; ++i) {
+      const Vec3& c = centres[pick(rng)];
+      const double spread = (i % 3 == 0 ? 0.0 : 2.0 * tolerance + 1e-3 * (i % 2));
+      mesh.vertices.push_back(c + spread * Vec3(unit(rng), unit(rng), unit(rng)));
+    }
+    std::uniform_int_distribution<std::uint32_t> vertex(0,
+                                                        static_cast<std::uint32_t>(mesh.vertices.size() - 1));
+    for (int i = 0; i < 400; ++i)
+      mesh.triangles.push_back({vertex(rng), vertex(rng), vertex(rng)});
+    TriangleMesh fast = mesh, plain = mesh;
+    const WeldReport a = weldVertices(fast, tolerance);
+    const WeldReport b = weldVerticesBruteForce(plain, tolerance);
+    EXPECT_EQ(a.verticesMerged, b.verticesMerged);
+    EXPECT_EQ(a.facesCollapsed, b.facesCollapsed);
+    EXPECT_EQ(fast.vertices, plain.vertices);
+    EXPECT_EQ(fast.triangles, plain.triangles);
+    EXPECT_GT(a.verticesMerged, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace shapedb::core
