@@ -22,6 +22,7 @@ namespace shapedb::cli {
 namespace {
 
 struct BenchCommandOptions {
+  MeshLoadFlags load;
   std::string database;
   std::string queries;
   std::string fractureMesh;
@@ -38,13 +39,13 @@ Result<std::vector<io::NamedMesh>> loadShapes(const BenchCommandOptions& o) {
     Result<std::vector<std::filesystem::path>> files = io::listMeshFiles(o.queries);
     if (!files) return files.error();
     for (const std::filesystem::path& file : *files) {
-      Result<io::LoadedMesh> loaded = loadMeshFile(file);
+      Result<io::LoadedMesh> loaded = loadMeshFile(file, o.load);
       if (!loaded) return loaded.error();  // names the file
       shapes.push_back({file.stem().string(), file.string(), std::move(loaded->mesh)});
     }
     return shapes;
   }
-  Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.fracture);
+  Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.load, o.fracture);
   if (!pieces) return pieces.error();
   for (std::size_t i = 0; i < pieces->fragments.size(); ++i) {
     char name[32];
@@ -157,6 +158,7 @@ Command addBenchCommand(CLI::App& parent) {
       ->check(CLI::Range(1, 1000))
       ->needs(fractureOption);
   addFractureFlags(*app, o->fracture);
+  addMeshLoadFlags(*app, o->load);
   app->add_option("--out", o->out, "Directory for the results (created)")->required();
   addMaterialFlags(*app, o->material);
   app->add_option("--frequencies", o->evaluation.frequencies, "Non-rigid frequencies compared per shape")

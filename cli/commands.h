@@ -38,8 +38,15 @@ Command addBenchCommand(CLI::App& parent);
 Command addSoundCommand(CLI::App& parent);
 Command addDropCommand(CLI::App& parent);
 
+/// How the mesh files a command reads are interpreted: their unit and welding (--units, --scale,
+/// --weld-tolerance), on every command that reads meshes.
+struct MeshLoadFlags {
+  io::LoadOptions options;
+  std::string units;  ///< as given ("" when neither --units nor --scale was)
+};
+
 /// Loads a mesh file and fractures it; errors name the file. Shared by fracture and haptic --fracture.
-Result<volume::FractureResult> fractureMeshFile(const std::string& path,
+Result<volume::FractureResult> fractureMeshFile(const std::string& path, const MeshLoadFlags& load,
                                                 const volume::FractureOptions& options);
 /// Adds --seed and --resolution for `options`.
 void addFractureFlags(CLI::App& app, volume::FractureOptions& options);
@@ -47,8 +54,12 @@ void addFractureFlags(CLI::App& app, volume::FractureOptions& options);
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);
 
-/// io::loadMesh, and what it did to the file's mesh (a surface wound inward, flipped) printed on stderr
-/// as "shapedb: warning: <file>: <note>". Every command that reads a mesh file reads it through this.
-Result<io::LoadedMesh> loadMeshFile(const std::string& path, const io::LoadOptions& options = {});
+/// Adds --units, --scale and --weld-tolerance to `app`.
+void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags);
+
+/// io::loadMesh, and what it did to the file's mesh (a surface wound inward and flipped, vertices
+/// welded) printed on stderr as "shapedb: warning: <file>: <note>"; so is a size that suggests another
+/// unit than metres, when none was given. Every command that reads a mesh file reads it through this.
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags = {});
 
 }  // namespace shapedb::cli

@@ -233,6 +233,7 @@ int runInfo(const InfoOptions& o) {
 }
 
 struct AddOptions {
+  MeshLoadFlags load;
   std::string path;
   std::vector<std::string> meshes;
 };
@@ -240,7 +241,7 @@ struct AddOptions {
 int runAdd(const AddOptions& o) {
   std::vector<io::NamedMesh> meshes;
   for (const std::string& file : o.meshes) {
-    auto loaded = loadMeshFile(file);
+    auto loaded = loadMeshFile(file, o.load);
     if (!loaded) {
       printError(loaded.error().message);
       return kExitInputError;
@@ -325,6 +326,7 @@ Command addAddCommand(CLI::App& parent) {
       "§7), computed with the database's own parameters; all are added or none.");
   app->add_option("DB", o->path, "Database file")->required();
   app->add_option("MESH", o->meshes, "Closed surface mesh files (.obj, .ply, .off, .stl)")->required();
+  addMeshLoadFlags(*app, o->load);
   return {app, [o] { return runAdd(*o); }};
 }
 

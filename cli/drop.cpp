@@ -29,6 +29,7 @@ namespace shapedb::cli {
 namespace {
 
 struct DropCommandOptions {
+  MeshLoadFlags load;
   std::string database;
   std::vector<std::string> meshes;
   std::string fractureMesh;
@@ -80,7 +81,7 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
   std::vector<core::TriangleMesh> meshes;
   std::vector<std::string> names;
   if (!o.fractureMesh.empty()) {
-    Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.fracture);
+    Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.load, o.fracture);
     if (!pieces) {
       printError(pieces.error().message);
       return kExitInputError;
@@ -91,7 +92,7 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
     }
   } else {
     for (const std::string& file : o.meshes) {
-      Result<io::LoadedMesh> loaded = loadMeshFile(file);
+      Result<io::LoadedMesh> loaded = loadMeshFile(file, o.load);
       if (!loaded) {
         printError(loaded.error().message);
         return kExitInputError;
@@ -274,6 +275,7 @@ Command addDropCommand(CLI::App& parent) {
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   addFractureFlags(*app, o->fracture);
+  addMeshLoadFlags(*app, o->load);
   addMaterialFlags(*app, o->material);
   app->add_option("--height", o->height, "Height of the lowest point at the start (m)")
       ->capture_default_str()

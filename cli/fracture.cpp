@@ -16,6 +16,7 @@ namespace shapedb::cli {
 namespace {
 
 struct FractureCommandOptions {
+  MeshLoadFlags load;
   std::string mesh;
   std::string out;
   std::string format = "obj";
@@ -24,7 +25,7 @@ struct FractureCommandOptions {
 
 int runFracture(const FractureCommandOptions& o) {
   const auto start = std::chrono::steady_clock::now();
-  Result<volume::FractureResult> pieces = fractureMeshFile(o.mesh, o.fracture);
+  Result<volume::FractureResult> pieces = fractureMeshFile(o.mesh, o.load, o.fracture);
   if (!pieces) {
     printError(pieces.error().message);
     return kExitInputError;
@@ -66,9 +67,9 @@ int runFracture(const FractureCommandOptions& o) {
 
 }  // namespace
 
-Result<volume::FractureResult> fractureMeshFile(const std::string& path,
+Result<volume::FractureResult> fractureMeshFile(const std::string& path, const MeshLoadFlags& load,
                                                 const volume::FractureOptions& options) {
-  Result<io::LoadedMesh> loaded = loadMeshFile(path);
+  Result<io::LoadedMesh> loaded = loadMeshFile(path, load);
   if (!loaded) return loaded.error();
   Result<volume::FractureResult> pieces = volume::fracture(loaded->mesh, options);
   if (!pieces) return withContext(pieces.error(), path);
@@ -108,6 +109,7 @@ Command addFractureCommand(CLI::App& parent) {
       ->capture_default_str()
       ->check(CLI::IsMember({"obj", "ply"}));
   addFractureFlags(*app, o->fracture);
+  addMeshLoadFlags(*app, o->load);
   return {app, [o] { return runFracture(*o); }};
 }
 

@@ -22,6 +22,7 @@ namespace shapedb::cli {
 namespace {
 
 struct HapticCommandOptions {
+  MeshLoadFlags load;
   std::string database;
   std::string scene;
   std::string fractureMesh;
@@ -125,10 +126,10 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   }
   Result<std::vector<haptics::SceneObject>> scene = std::vector<haptics::SceneObject>{};
   if (!o.scene.empty()) {
-    scene = haptics::loadScene(o.scene);
+    scene = haptics::loadScene(o.scene, o.load.options);
   } else {
     // The fragments stay where the fracture left them: the broken object, in its own frame.
-    Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.fracture);
+    Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.load, o.fracture);
     if (!pieces) {
       scene = pieces.error();
     } else {
@@ -224,6 +225,7 @@ Command addHapticCommand(CLI::App& parent) {
       ->check(CLI::Range(1, 1000))
       ->needs(fractureOption);
   addFractureFlags(*app, o->fracture);
+  addMeshLoadFlags(*app, o->load);
   app->add_option("--report", o->report, "JSON report file")->required();
   app->add_option("--rate", o->loop.rateHz, "Loop rate, Hz")
       ->capture_default_str()

@@ -36,13 +36,15 @@ nlohmann::json topologyJson(const io::LoadedMesh& loaded) {
           {"is_consistently_oriented", t.isConsistentlyOriented()},
           {"zero_area_faces", loaded.defects.zeroAreaFaces},
           {"faces_dropped", loaded.facesDropped},
-          {"polygons_triangulated", loaded.polygonsTriangulated}};
+          {"polygons_triangulated", loaded.polygonsTriangulated},
+          {"welded_vertices", loaded.verticesWelded}};
 }
 
 nlohmann::json reportJson(const InspectOptions& options, const io::LoadedMesh& loaded,
                           const core::MassProperties& mp, const core::Normalization& n) {
   return {{"file", options.meshPath},
           {"format", loaded.format},
+          {"scale", loaded.scale},
           {"topology", topologyJson(loaded)},
           {"density", mp.density},
           {"mass", mp.mass},

@@ -12,14 +12,6 @@ void printError(const std::string& message) {
   std::fprintf(stderr, "shapedb: %s\n", message.c_str());
 }
 
-Result<io::LoadedMesh> loadMeshFile(const std::string& path, const io::LoadOptions& options) {
-  Result<io::LoadedMesh> loaded = io::loadMesh(path, options);
-  if (loaded)
-    for (const std::string& note : loaded->notes())
-      std::fprintf(stderr, "shapedb: warning: %s: %s\n", path.c_str(), note.c_str());
-  return loaded;
-}
-
 }  // namespace shapedb::cli
 
 int main(int argc, char** argv) {

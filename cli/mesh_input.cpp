@@ -1,8 +1,61 @@
 #include "mesh_input.h"
 
+#include <cstdio>
+
 #include "commands.h"
 
 namespace shapedb::cli {
+
+void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
+  CLI::Option* units =
+      app.add_option_function<std::string>(
+             "--units",
+             [&flags](const std::string& unit) {
+               flags.units = unit;
+               flags.options.scale = *io::unitScale(unit);
+             },
+             "The mesh files' unit: mm, cm, m, in or ft [default: m; a mesh over 10 m or under 1 mm across\n"
+             "gets a warning naming the likely unit]")
+          ->check(CLI::IsMember({"mm", "cm", "m", "in", "ft"}));
+  app.add_option_function<double>(
+         "--scale",
+         [&flags](double scale) {
+           flags.units = "scale";
+           flags.options.scale = scale;
+         },
+         "Multiply the mesh files' coordinates by this to get metres")
+      ->check(CLI::PositiveNumber)
+      ->excludes(units);
+  app.add_option("--weld-tolerance", flags.options.weldTolerance,
+                 "An open surface's vertices closer than this fraction of its bounding box's diagonal are\n"
+                 "welded into one (exactly coincident ones always are)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.01));
+}
+
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags) {
+  Result<io::LoadedMesh> loaded = io::loadMesh(path, flags.options);
+  if (!loaded) return loaded;
+  for (const std::string& note : loaded->notes())
+    std::fprintf(stderr, "shapedb: warning: %s: %s\n", path.c_str(), note.c_str());
+  if (flags.units.empty() && !loaded->mesh.vertices.empty()) {
+    const core::Bounds bounds = core::computeBounds(loaded->mesh);
+    const double size = (bounds.max - bounds.min).maxCoeff();
+    if (size > 10.0)
+      std::fprintf(
+          stderr,
+          "shapedb: warning: %s: the mesh is %.4g m across, read in metres; if its unit is millimetres "
+          "(as CAD exports often are), give --units mm (inches: --units in)\n",
+          path.c_str(), size);
+    else if (size < 1e-3)
+      std::fprintf(
+          stderr,
+          "shapedb: warning: %s: the mesh is %.3g mm across, read in metres; if that is not its unit, "
+          "give --units or --scale\n",
+          path.c_str(), size * 1e3);
+  }
+  return loaded;
+}
 
 void addMeshInputFlags(CLI::App& app, MeshInputOptions& options) {
   app.add_option("--density", options.density, "Density in kg/m³ for mass and inertia")
@@ -14,10 +67,13 @@ void addMeshInputFlags(CLI::App& app, MeshInputOptions& options) {
   app.add_flag("--flip-inside-out", options.flipInsideOut, "Accept a mesh wound inward by flipping it");
   app.add_flag("--allow-degenerate", options.allowDegenerate,
                "Accept degenerate faces (dropped if a vertex repeats, kept if only their area is zero)");
+  addMeshLoadFlags(app, options.load);
 }
 
 std::optional<MeshInput> loadMeshInput(const std::string& path, const MeshInputOptions& options) {
-  Result<io::LoadedMesh> loaded = loadMeshFile(path, {.allowDegenerateFaces = options.allowDegenerate});
+  MeshLoadFlags load = options.load;
+  load.options.allowDegenerateFaces = options.allowDegenerate;
+  Result<io::LoadedMesh> loaded = loadMeshFile(path, load);
   if (!loaded) {
     printError(loaded.error().message);
     return std::nullopt;

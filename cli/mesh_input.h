@@ -11,6 +11,8 @@
 #include <shapedb/core/normalize.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "commands.h"
+
 namespace shapedb::cli {
 
 /// The flags that decide which meshes are accepted, and the density for mass properties.
@@ -19,9 +21,10 @@ struct MeshInputOptions {
   bool approximate = false;
   bool flipInsideOut = false;
   bool allowDegenerate = false;
+  MeshLoadFlags load;
 };
 
-/// Adds --density, --approximate, --flip-inside-out and --allow-degenerate to `app`.
+/// Adds --density, --approximate, --flip-inside-out, --allow-degenerate and the load flags to `app`.
 void addMeshInputFlags(CLI::App& app, MeshInputOptions& options);
 
 /// A mesh loaded, with its mass properties and canonical frame.

@@ -24,6 +24,7 @@ namespace shapedb::cli {
 namespace {
 
 struct QueryCommandOptions {
+  MeshLoadFlags load;
   std::string database;
   std::vector<std::string> meshes;
   int k = 1;
@@ -272,7 +273,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   if (o.table && !o.json) printTableHeader();
   for (std::size_t i = 0; i < o.meshes.size(); ++i) {
     const std::string& file = o.meshes[i];
-    auto loaded = loadMeshFile(file);
+    auto loaded = loadMeshFile(file, o.load);
     if (!loaded) {
       printError(loaded.error().message);
       status = kExitInputError;
@@ -297,7 +298,9 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
     if (o.json) {
       nlohmann::json q = {{"file", file},
                           {"triangles", loaded->mesh.triangleCount()},
+                          {"scale", loaded->scale},
                           {"flipped_inside_out", loaded->flippedInsideOut},
+                          {"welded_vertices", loaded->verticesWelded},
                           {"volume", result->massProperties.volume},
                           {"size", std::cbrt(result->massProperties.volume)},
                           {"descriptor", o.descriptor},
@@ -337,6 +340,7 @@ Command addQueryCommand(CLI::App& parent) {
       "Meshes must be closed and consistently oriented. Exit status 1 if any mesh failed.");
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
   app->add_option("MESH", o->meshes, "Query surface meshes (.obj, .ply, .off, .stl)")->required();
+  addMeshLoadFlags(*app, o->load);
   app->add_option("-k,--k", o->k, "Matches to report, best first")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));

@@ -21,6 +21,7 @@ namespace shapedb::cli {
 namespace {
 
 struct SoundCommandOptions {
+  MeshLoadFlags load;
   std::string database;
   std::string mesh;
   std::string out;
@@ -45,7 +46,7 @@ std::vector<core::Vec3> vertexNormals(const core::TriangleMesh& mesh) {
 int runSound(const SoundCommandOptions& o, const CLI::App& app) {
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
-  Result<io::LoadedMesh> loaded = loadMeshFile(o.mesh);
+  Result<io::LoadedMesh> loaded = loadMeshFile(o.mesh, o.load);
   if (!loaded) {
     printError(loaded.error().message);
     return kExitInputError;
@@ -117,7 +118,8 @@ Command addSoundCommand(CLI::App& parent) {
       "a damped sinusoid (the database's Rayleigh damping), excited through the linking weights there.\n"
       "The level is normalized (peak 0.9); radiation efficiency is not modelled.");
   app->add_option("DB", o->database, "Database file (from shapedb build)")->required();
-  app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl), metres")->required();
+  app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl)")->required();
+  addMeshLoadFlags(*app, o->load);
   app->add_option("--out", o->out, "WAV file to write (16-bit PCM, mono)")->required();
   app->add_option("--impact", o->impact, "X,Y,Z: strike the vertex nearest this point (mesh frame, metres)")
       ->delimiter(',')

@@ -8,7 +8,7 @@ namespace shapedb::haptics {
 
 namespace fs = std::filesystem;
 
-Result<std::vector<SceneObject>> loadScene(const fs::path& directory) {
+Result<std::vector<SceneObject>> loadScene(const fs::path& directory, const io::LoadOptions& options) {
   std::error_code ec;
   if (!fs::is_directory(directory, ec))
     return Error{ErrorCode::kIo, directory.string() + ": not a directory (a scene is a directory of meshes)"};
@@ -18,7 +18,7 @@ Result<std::vector<SceneObject>> loadScene(const fs::path& directory) {
   std::vector<SceneObject> objects;
   objects.reserve(files->size());
   for (const fs::path& file : *files) {
-    Result<io::LoadedMesh> loaded = io::loadMesh(file);
+    Result<io::LoadedMesh> loaded = io::loadMesh(file, options);
     if (!loaded) return loaded.error();  // names the file
     objects.push_back({file.filename().string(), std::move(loaded->mesh)});
   }

@@ -11,6 +11,7 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <shapedb/core/weld.h>
 #include <shapedb/io/mesh_io.h>
 
 #include "openmesh_adapters.h"
@@ -175,6 +176,14 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
                                                       : readStl(path);
   if (!raw) return raw.error();
 
+  if (!(options.scale > 0.0 && std::isfinite(options.scale)))
+    return fileError(path, ErrorCode::kInvalidArgument, "the scale must be positive and finite");
+  if (!(options.weldTolerance >= 0.0 && options.weldTolerance < 1.0))
+    return fileError(path, ErrorCode::kInvalidArgument, "the weld tolerance must be a fraction in [0, 1)");
+  if (options.scale != 1.0)
+    for (core::Vec3& p : raw->vertices)
+      p *= options.scale;
+
   // Triangulate, then validate what was read.
   Triangulated tri = triangulate(std::move(raw).value());
   if (tri.tooFewCorners > 0 && !options.allowDegenerateFaces)
@@ -195,7 +204,22 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
     if (out.mesh.triangles.empty())
       return fileError(path, ErrorCode::kEmptyMesh, "mesh has no faces once degenerate faces are dropped");
   }
+  out.scale = options.scale;
   out.topology = core::analyzeTopology(out.mesh);
+  if (options.weld && !out.topology.isClosed()) {
+    const core::Bounds bounds = core::computeBounds(out.mesh);
+    core::TriangleMesh welded = out.mesh;
+    const core::WeldReport weld =
+        core::weldVertices(welded, options.weldTolerance * (bounds.max - bounds.min).norm());
+    const core::TopologyReport after = core::analyzeTopology(welded);
+    if (!welded.triangles.empty() && after.boundaryEdges + after.nonManifoldEdges <
+                                         out.topology.boundaryEdges + out.topology.nonManifoldEdges) {
+      out.mesh = std::move(welded);
+      out.topology = after;
+      out.verticesWelded = weld.verticesMerged;
+      out.facesCollapsedByWeld = weld.facesCollapsed;
+    }
+  }
   if (out.topology.isClosed() && out.topology.isConsistentlyOriented()) {
     out.signedVolumeAsRead = signedVolume(out.mesh);
     if (options.orientOutward && out.signedVolumeAsRead < 0.0) {
@@ -207,8 +231,25 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   return out;
 }
 
+std::optional<double> unitScale(std::string_view unit) {
+  if (unit == "mm") return 0.001;
+  if (unit == "cm") return 0.01;
+  if (unit == "m") return 1.0;
+  if (unit == "in") return 0.0254;
+  if (unit == "ft") return 0.3048;
+  return std::nullopt;
+}
+
 std::vector<std::string> LoadedMesh::notes() const {
   std::vector<std::string> out;
+  if (verticesWelded > 0)
+    out.push_back(std::to_string(verticesWelded) + " coincident vertices welded" +
+                  (facesCollapsedByWeld > 0 ? " (" + std::to_string(facesCollapsedByWeld) +
+                                                  " triangles collapsed to slivers removed)"
+                                            : std::string()) +
+                  (topology.boundaryEdges == 0
+                       ? ", which closed the surface"
+                       : ", leaving " + std::to_string(topology.boundaryEdges) + " boundary edges"));
   if (flippedInsideOut) {
     char text[160];
     std::snprintf(text, sizeof text,

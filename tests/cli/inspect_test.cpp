@@ -101,6 +101,28 @@ TEST(CliInspect, BadInputAndUsageGiveNonZeroExitAndAMessage) {
   EXPECT_EQ(shapedb({"inspect", (dir / "x.obj").string(), "--density", "-3"}).exitCode, 2);
 }
 
+TEST(CliInspect, AMillimetreMeshIsReadInItsUnitOrWarnedAbout) {
+  test::ScratchDir dir("cli-units");
+  const core::TriangleMesh tray = core::makeBox({300.0, 200.0, 10.0});  // a CAD export, in mm
+  ASSERT_TRUE(io::saveMesh(tray, dir / "tray.ply").ok());
+  const test::ProcessResult asMetres = shapedb({"inspect", (dir / "tray.ply").string(), "--json"});
+  ASSERT_EQ(asMetres.exitCode, 0) << asMetres.err;
+  EXPECT_NE(asMetres.err.find("--units mm"), std::string::npos) << asMetres.err;
+  const test::ProcessResult inMm =
+      shapedb({"inspect", (dir / "tray.ply").string(), "--json", "--units", "mm", "--density", "2700"});
+  ASSERT_EQ(inMm.exitCode, 0) << inMm.err;
+  EXPECT_EQ(inMm.err, "");
+  const nlohmann::json j = nlohmann::json::parse(inMm.out);
+  EXPECT_NEAR(j["volume"].get<double>(), 0.3 * 0.2 * 0.01, 1e-12);
+  EXPECT_NEAR(j["mass"].get<double>(), 2700.0 * 0.3 * 0.2 * 0.01, 1e-9);
+  EXPECT_EQ(j["scale"].get<double>(), 0.001);
+  const test::ProcessResult scaled =
+      shapedb({"inspect", (dir / "tray.ply").string(), "--json", "--scale", "0.001"});
+  ASSERT_EQ(scaled.exitCode, 0) << scaled.err;
+  EXPECT_EQ(nlohmann::json::parse(scaled.out)["volume"], j["volume"]);
+  EXPECT_NE(shapedb({"inspect", (dir / "tray.ply").string(), "--units", "furlong"}).exitCode, 0);
+}
+
 TEST(CliInspect, HelpExplains) {
   const test::ProcessResult top = shapedb({"--help"});
   EXPECT_EQ(top.exitCode, 0);

@@ -279,6 +279,56 @@ TEST(MeshIo, ASurfaceWoundInwardIsFlippedAtLoadAndSaysSo) {
   EXPECT_EQ(inconsistent.mesh.triangles, oneFace.triangles);
 }
 
+TEST(MeshIo, AnOpenSoupIsWeldedClosedAndAClosedSurfaceIsLeftAlone) {
+  test::ScratchDir dir("mesh-io-weld");
+  const TriangleMesh box = core::makeBox({0.3, 0.2, 0.1});
+  // As binary STL writers store surfaces: three corners per triangle, nothing shared. (OpenMesh's STL
+  // reader merges exactly equal corners itself, so the soup goes through OBJ.)
+  TriangleMesh soup;
+  for (const auto& t : box.triangles) {
+    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
+    for (const std::uint32_t v : t)
+      soup.vertices.push_back(box.vertices[v]);
+    soup.triangles.push_back({base, base + 1, base + 2});
+  }
+  test::writeFile(dir / "soup.obj", test::objText(soup));
+  const LoadedMesh welded = mustLoad(dir / "soup.obj");
+  EXPECT_TRUE(welded.topology.isClosed());
+  EXPECT_EQ(welded.verticesWelded, soup.vertices.size() - box.vertices.size());
+  EXPECT_NEAR(volumeOf(welded.mesh), 0.006, 1e-12);
+  ASSERT_EQ(welded.notes().size(), 1u);
+  EXPECT_NE(welded.notes().front().find("welded"), std::string::npos);
+  EXPECT_FALSE(mustLoad(dir / "soup.obj", {.weld = false}).topology.isClosed());
+
+  // Two closed boxes that share an edge's positions (an assembly exported as one file): each is closed
+  // as read, so nothing is welded into a non-manifold edge.
+  TriangleMesh pair = box;
+  const auto offset = static_cast<std::uint32_t>(pair.vertices.size());
+  for (const Vec3& p : box.vertices)
+    pair.vertices.push_back(p + Vec3(0.3, 0.2, 0.0));
+  for (const auto& t : box.triangles)
+    pair.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  test::writeFile(dir / "pair.obj", test::objText(pair));
+  const LoadedMesh asIs = mustLoad(dir / "pair.obj");
+  EXPECT_EQ(asIs.verticesWelded, 0u);
+  EXPECT_EQ(asIs.mesh.vertices.size(), pair.vertices.size());
+  EXPECT_TRUE(asIs.topology.isClosed());
+}
+
+TEST(MeshIo, UnitsScaleTheCoordinatesAsTheyAreRead) {
+  test::ScratchDir dir("mesh-io-units");
+  test::writeFile(dir / "tray_mm.obj", test::objText(core::makeBox({300.0, 200.0, 10.0})));
+  EXPECT_EQ(unitScale("mm"), 0.001);
+  EXPECT_EQ(unitScale("in"), 0.0254);
+  EXPECT_EQ(unitScale("ft"), 0.3048);
+  EXPECT_FALSE(unitScale("furlong").has_value());
+  const LoadedMesh metres = mustLoad(dir / "tray_mm.obj", {.scale = *unitScale("mm")});
+  EXPECT_EQ(metres.scale, 0.001);
+  EXPECT_NEAR(volumeOf(metres.mesh), 0.3 * 0.2 * 0.01, 1e-12);
+  EXPECT_EQ(mustFail(dir / "tray_mm.obj", {.scale = 0.0}).code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mustFail(dir / "tray_mm.obj", {.scale = -1.0}).code, ErrorCode::kInvalidArgument);
+}
+
 TEST(MeshIo, SaveRejectsUnknownFormatsAndInvalidMeshes) {
   test::ScratchDir dir("io");
   const TriangleMesh box = core::makeBox({1, 1, 1});

@@ -9,14 +9,17 @@
 #include <shapedb/core/result.h>
 #include <shapedb/haptics/loop.h>
 #include <shapedb/io/database.h>
+#include <shapedb/io/mesh_io.h>
 
 namespace shapedb::haptics {
 
 /// Every mesh file (OBJ, PLY, OFF, STL) directly in `directory`, in name order, each an object in the
 /// world frame (metres) named after its file. A file that does not read is an error naming it; a mesh
 /// that reads but cannot be queried (say, open) is loaded, and its augmentation fails in the loop with
-/// that reason. Errors: kIo (not a directory, or no mesh in it), and loadMesh's.
-Result<std::vector<SceneObject>> loadScene(const std::filesystem::path& directory);
+/// that reason. Each file is read with `options` (its unit, welding). Errors: kIo (not a directory, or no
+/// mesh in it), and loadMesh's.
+Result<std::vector<SceneObject>> loadScene(const std::filesystem::path& directory,
+                                           const io::LoadOptions& options = {});
 
 /// Augmentation by the database (Algorithm 1): query, fetch, adapt to `options.material`, link. The
 /// contact locator is the entry's own, shared through the database's cache. `options.adapt` and

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <shapedb/core/result.h>
@@ -19,7 +21,21 @@ struct LoadOptions {
   /// exporters write) is flipped, and LoadedMesh::flippedInsideOut says so. An inconsistently oriented
   /// one is left as it is: no flip can fix it, and the stages that need a solid refuse it.
   bool orientOutward = true;
+  /// Coordinates are multiplied by this as they are read (the file's unit in metres: unitScale("mm") is
+  /// 0.001). Positive and finite.
+  double scale = 1.0;
+  /// A surface that is open as read has its coincident vertices welded (core::weldVertices), and the
+  /// weld is kept if it closes edges: a triangle soup, or a mesh split along texture seams, becomes the
+  /// surface it describes. A closed surface is never welded (two solids touching along an edge would
+  /// become non-manifold).
+  bool weld = true;
+  /// Vertices closer than this fraction of the bounding box's diagonal are coincident; 0: exactly equal
+  /// positions only.
+  double weldTolerance = 0.0;
 };
+
+/// Metres per unit for "mm", "cm", "m", "in" and "ft"; nothing for any other name.
+std::optional<double> unitScale(std::string_view unit);
 
 /// A mesh read from a file, with what was learnt about it on the way in. Plain value type.
 struct LoadedMesh {
@@ -30,6 +46,9 @@ struct LoadedMesh {
   std::size_t polygonsTriangulated = 0;  ///< faces with more than three vertices, fan-triangulated
   std::size_t facesDropped = 0;          ///< repeated-vertex faces dropped under allowDegenerateFaces
   bool flippedInsideOut = false;         ///< wound inward as read, flipped (LoadOptions::orientOutward)
+  std::size_t verticesWelded = 0;        ///< coincident vertices merged (LoadOptions::weld)
+  std::size_t facesCollapsedByWeld = 0;  ///< triangles the weld left with a repeated corner, removed
+  double scale = 1.0;                    ///< LoadOptions::scale, applied
   double signedVolumeAsRead = 0.0;       ///< of a closed, consistent surface as read (m³), else 0
 
   /// What a user should hear about the file's mesh ("the surface was wound inward ... flipped"), one
