@@ -1,4 +1,4 @@
-// Building the shape database (issue 4): throughput at 1 and 2 threads, time per stage, bytes on disk.
+// Building the shape database: throughput at 1 and 2 threads, time per stage, bytes on disk.
 // Targets on the 2-core reference machine: the default database (1,800 entries, 20 modes) in <= 10 min,
 // i.e. >= 7.5 entries/s on 2 threads; the demo's database in <= 2 min.
 //   build/release/bin/build_bench

@@ -1,4 +1,4 @@
-// The haptic loop (issue 7): a scene of fragments, the proxy sweeping through it, the loop at 1 kHz in
+// The haptic loop: a scene of fragments, the proxy sweeping through it, the loop at 1 kHz in
 // real time for 10 s while a worker augments the fragments it comes near from the database.
 //   build/release/bin/haptic_bench [DB] [--objects N] [--seconds S] [--rate HZ] [--workers W]
 //                                  [--speed M_PER_S] [--scene-out DIR]

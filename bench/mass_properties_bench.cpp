@@ -1,5 +1,5 @@
 // The first stage of a query: mass properties and normalization of a surface mesh.
-// Target (issue 2): mass properties + normalization <= 50 us for 5k triangles on one core; the paper
+// Target: mass properties + normalization <= 50 us for 5k triangles on one core; the paper
 // tetrahedralized the query with TetGen instead (milliseconds).
 //   build/release/bin/mass_properties_bench --benchmark_repetitions=10 --benchmark_report_aggregates_only
 

@@ -112,7 +112,7 @@ TEST(Collision, ABoxIsOneBoxAndASphereIsCoveredWithLittleOvershoot) {
   EXPECT_LT(sphere->overshoot, 0.05);
 
   // A capsule along x: mostly covered, little overshoot. (Voxel centres sit half a voxel off its axis,
-  // so the fitted capsules are thinner than the real one: a known weakness, see the issue 4 note.)
+  // so the fitted capsules are thinner than the real one: a known weakness of fitting to voxel centres.)
   const core::TriangleMesh capsule = core::transformed(core::makeCapsule(0.3, 2.0, 24, 8), [] {
     core::Mat4 t = core::Mat4::Identity();
     t.topLeftCorner<3, 3>() << 0, 0, 1, 0, 1, 0, -1, 0, 0;

@@ -19,8 +19,8 @@ struct OrientationOptions {
   int sphereSamples = 72;
 };
 
-/// The rotations candidateFromCanonical that a query tries (paper §3.1 leaves them open; DESIGN.md,
-/// "two known weaknesses"), identity first, then:
+/// The rotations candidateFromCanonical that a query tries (paper §3.1 leaves them open, one of its weak
+/// points: docs/architecture.md, "The second stage"), identity first, then:
 /// - each axis flip the sign rule left ambiguous (rotations by π about y, x, or z, keeping det +1);
 /// - within a degenerate eigenspace, rotations about the distinct axis (kXY, kYZ) or a sample of all
 ///   rotations (kAll).

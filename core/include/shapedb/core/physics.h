@@ -2,7 +2,7 @@
 
 // The physical data a database entry carries (paper §3.1), in the entry's canonical frame: unit volume,
 // centre of mass at the origin, principal axes on x, y, z. Everything is stored for unit density and unit
-// Young's modulus; adaptation (issue 5) scales it to the query's size and material.
+// Young's modulus; adaptation (core/adapt.h) scales it to the query's size and material.
 
 #include <array>
 #include <cstdint>

@@ -1,8 +1,8 @@
 #pragma once
 
-// The haptic-rate loop (DESIGN.md, "The haptic loop"). A dedicated thread ticks at a fixed rate against a
-// steady clock. Each tick reads the proxy, posts the objects that came within the augmentation radius
-// to worker threads (query, fetch, adapt, link: whatever the AugmentFunction does), and picks up the
+// The haptic-rate loop (docs/architecture.md, "The haptic loop"). A dedicated thread ticks at a fixed rate
+// against a steady clock. Each tick reads the proxy, posts the objects that came within the augmentation
+// radius to worker threads (query, fetch, adapt, link: whatever the AugmentFunction does), and picks up the
 // ones the workers have published, through one atomic pointer per object. Augmented objects in contact
 // with the proxy respond through their modes and push back on it. A tick never waits for a worker, and
 // never allocates, locks, logs or throws.
