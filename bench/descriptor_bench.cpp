@@ -1,4 +1,4 @@
-// Describing a mesh and searching the index (issue 3).
+// Describing a mesh and searching the index.
 // Targets on the 2-core reference machine:
 //   describe + search <= 50 us p50 for a 5k-triangle mesh against 4,500 entries on one core
 //   (the paper: 4 ms per fragment); search <= 1 ms p50 against 1M entries; <= 1 KiB per entry for
@@ -23,11 +23,14 @@
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/statistics.h>
 #include <shapedb/volume/describe.h>
 
 #include "synthetic.h"
 
 namespace {
+
+using shapedb::core::percentile;
 
 using namespace shapedb;
 
@@ -103,11 +106,6 @@ const core::Index& indexOf(core::DescriptorKind kind, std::int64_t entries,
     slot = std::make_unique<core::Index>(*std::move(builder).build());
   }
   return *slot;
-}
-
-double percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
 }
 
 void BM_Search(benchmark::State& state) {

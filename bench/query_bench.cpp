@@ -1,4 +1,4 @@
-// The whole query (issue 5): p50 and p99 of each stage for 5k- and 50k-triangle query meshes.
+// The whole query: p50 and p99 of each stage for 5k- and 50k-triangle query meshes.
 //   build/release/bin/query_bench [DB] [--queries N] [--csv FILE] [--no-fidelity] [--descriptor KIND]
 //   (DB default: build/demo.db; --no-fidelity: skip the fidelity report, to profile the rest;
 //   --descriptor: moment, voxel or centroid-voxel, the default)
@@ -24,11 +24,13 @@
 
 #include <shapedb/core/descriptor.h>
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/statistics.h>
 #include <shapedb/io/database.h>
 
 namespace {
 
 using shapedb::core::Mat4;
+using shapedb::core::percentile;
 using shapedb::core::TriangleMesh;
 using shapedb::core::Vec3;
 
@@ -51,12 +53,6 @@ TriangleMesh makeBlob(std::mt19937_64& rng, int n) {
   pose.topLeftCorner<3, 3>() = (0.01 + 2.0 * u(rng)) * q.normalized().toRotationMatrix();
   pose.topRightCorner<3, 1>() = Vec3(u(rng), u(rng), u(rng)) * 10.0;
   return shapedb::core::transformed(mesh, pose);
-}
-
-double percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size()))) - 1;
-  return v[std::min(i, v.size() - 1)];
 }
 
 }  // namespace

@@ -297,9 +297,8 @@ Command addBuildCommand(CLI::App& parent) {
   app->add_option("--sampling", o->sampling, "Descriptor sampling: area or vertices")
       ->capture_default_str()
       ->check(CLI::IsMember({"area", "vertices"}));
-  app->add_option("--poisson", o->poisson, "Poisson ratio of the modal analysis")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.499));
+  app->add_option("--poisson", o->poisson, "Poisson ratio of the modal analysis, in (-1, 0.5)")
+      ->capture_default_str();
   app->add_option("--batch", o->batch, "Entries per transaction")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));

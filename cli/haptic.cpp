@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <shapedb/core/descriptor.h>
+#include <shapedb/core/statistics.h>
 #include <shapedb/haptics/scene.h>
 #include <shapedb/io/database.h>
 
@@ -109,9 +110,7 @@ haptics::TrajectoryDevice defaultSweep(const std::vector<haptics::SceneObject>& 
     hi = hi.cwiseMax(b.max);
     widths.push_back((b.max - b.min).head<2>().maxCoeff());
   }
-  std::nth_element(widths.begin(), widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2),
-                   widths.end());
-  const double width = std::max(widths[widths.size() / 2], 1e-9);
+  const double width = std::max(core::median(widths), 1e-9);
   const int lanes = std::clamp(static_cast<int>(std::ceil((hi.y() - lo.y()) / width)), 1, 200);
   return haptics::TrajectoryDevice::sweep(lo, hi, lanes, speed);
 }

@@ -7,6 +7,7 @@
 #include <pthread.h>
 #include <sys/resource.h>
 
+#include <shapedb/core/statistics.h>
 #include <shapedb/haptics/contact.h>
 #include <shapedb/haptics/loop.h>
 
@@ -29,14 +30,9 @@ double secondsBetween(Clock::time_point a, Clock::time_point b) {
 Percentiles percentiles(std::vector<double> values) {
   Percentiles p;
   if (values.empty()) return p;
-  std::sort(values.begin(), values.end());
-  const auto at = [&](double q) {
-    const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
-    return values[std::min(i, values.size() - 1)];
-  };
-  p.p50 = at(0.50);
-  p.p99 = at(0.99);
-  p.max = values.back();
+  p.p50 = core::percentile(values, 0.50);
+  p.p99 = core::percentile(values, 0.99);
+  p.max = *std::max_element(values.begin(), values.end());
   return p;
 }
 

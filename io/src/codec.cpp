@@ -4,6 +4,8 @@
 #include <limits>
 #include <zlib.h>
 
+#include <shapedb/core/material.h>
+
 namespace shapedb::io {
 namespace {
 
@@ -99,7 +101,7 @@ Result<core::Descriptor> decodeDescriptor(const void* data, std::size_t size) {
 }
 
 Bytes encodeTetMesh(const core::TetMesh& mesh) {
-  // Nodes in double precision: the linking of issue 5 reproduces surface positions from them.
+  // Nodes in double precision: linking (core/adapt.h) reproduces surface positions from them.
   ByteWriter w;
   w.put(static_cast<std::uint32_t>(mesh.nodes.size()));
   w.put(static_cast<std::uint32_t>(mesh.tets.size()));
@@ -158,8 +160,8 @@ Result<core::ModalData> decodeModes(const void* data, std::size_t size) {
   if (!(r.get(modes.poissonRatio) && r.get(rows) && r.get(count))) return corrupted("modes");
   for (double& v : modes.rigidEigenvalues)
     if (!r.get(v) || !std::isfinite(v)) return corrupted("modes");
-  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0 || !finiteAtLeast(modes.poissonRatio, 0.0) ||
-      modes.poissonRatio >= 0.5)
+  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0 ||
+      !core::validPoissonRatio(modes.poissonRatio))
     return corrupted("modes");
   modes.eigenvalues.resize(count);
   modes.shapes.resize(rows, count);

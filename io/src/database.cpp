@@ -41,8 +41,8 @@ Status validateParameters(const BuildParameters& p) {
   if (Status st = volume::validateDescriptorOptions(p.entry.descriptor); !st) return st;
   if (p.entry.modal.modes < 1 || p.entry.modal.modes > 200)
     return Error{ErrorCode::kInvalidArgument, "modes must be in [1, 200]"};
-  if (!(p.entry.modal.material.poissonRatio >= 0.0 && p.entry.modal.material.poissonRatio < 0.5))
-    return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in [0, 0.5)"};
+  if (!core::validPoissonRatio(p.entry.modal.material.poissonRatio))
+    return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in (-1, 0.5)"};
   return Ok{};
 }
 
@@ -458,10 +458,9 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       core::TriangleMesh target = mesh;
       for (core::Vec3& p : target.vertices)
         p = placement.toEntry(p);
-      // The modes are computed again anyway: with the material's own Poisson ratio where the FEM takes it.
+      // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
       volume::ModalOptions modal = parameters().entry.modal;
-      if (volume::validPoissonRatio(options.material.poissonRatio))
-        modal.material.poissonRatio = options.material.poissonRatio;
+      modal.material.poissonRatio = options.material.poissonRatio;
       auto c = volume::correctGeometry(best.data, target, modal, options.correction);
       if (c) {
         out.correction = c->report;

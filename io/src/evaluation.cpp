@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/statistics.h>
 #include <shapedb/core/stretch.h>
 #include <shapedb/io/evaluation.h>
 #include <shapedb/io/plot.h>
@@ -21,6 +22,8 @@ namespace shapedb::io {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using core::median;
+using core::percentile;
 /// The queries of each shape: the three descriptors as a query makes them (`momentWeight` unset: the
 /// default), then the centroid-voxel descriptor by the paper's distance alone, then the centroid-voxel
 /// query with the geometry correction.
@@ -63,24 +66,6 @@ Result<Eigen::VectorXd> directFrequencies(const core::TriangleMesh& surface,
   Result<core::ModalData> modes = volume::computeModes(*tets, entry.modal);
   if (!modes) return modes.error();
   return Eigen::VectorXd(modes->frequenciesHz() * std::sqrt(material.youngsModulus / material.density));
-}
-
-double median(std::vector<double> v) {
-  std::erase_if(v, [](double x) { return !std::isfinite(x); });
-  if (v.empty()) return MethodEvaluation::kNaN;
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  const double upper = v[mid];
-  if (v.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-}
-
-double percentile(std::vector<double> v, double q) {
-  std::erase_if(v, [](double x) { return !std::isfinite(x); });
-  if (v.empty()) return MethodEvaluation::kNaN;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1,
-                    static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1)];
 }
 
 /// Fills one baseline: the inertia-equivalent solid `surface` (made in its principal frame, centred),

@@ -275,7 +275,7 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
   auto tets = volume::tetrahedralize(surface, options.tetgen);
   ASSERT_TRUE(tets.ok()) << tets.error().message;
   auto direct =
-      volume::computeModes(*tets, {.modes = 4, .material = {}, .order = volume::ElementOrder::kQuadratic});
+      volume::computeModes(*tets, {.modes = 4, .material = core::unitMaterial(), .order = volume::ElementOrder::kQuadratic});
   ASSERT_TRUE(direct.ok()) << direct.error().message;
   ASSERT_EQ(physics["frequencies_hz"].size(), 4u);
   for (int i = 0; i < 4; ++i)

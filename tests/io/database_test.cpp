@@ -167,8 +167,7 @@ TEST_F(SmallDatabase, PhysicsReadBackMatchesAFreshComputation) {
   ASSERT_TRUE(all.ok()) << all.error().message;
   Eigen::MatrixXd shapes = all->shapes;
   shapes.topRows(p.modes.shapes.rows()) = p.modes.shapes;
-  const volume::FemMatrices fem =
-      volume::assembleFem(quadratic, {.youngsModulus = 1, .poissonRatio = 0.3, .density = 1});
+  const volume::FemMatrices fem = volume::assembleFem(quadratic, core::unitMaterial());
   const Eigen::MatrixXd gram = shapes.transpose() * fem.mass * shapes;
   EXPECT_LT((gram - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff(), 1e-3);
   EXPECT_EQ(p.collision.shapes.size(), fresh->physics.collision.shapes.size());
@@ -229,8 +228,7 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     EXPECT_LT(c->correction->morph.maxBoundaryMove, 1e-9) << e.name;
     EXPECT_LT(c->correction->morph.meanTargetDistance, 1e-9) << e.name;
     volume::ModalOptions glassModal = db->parameters().entry.modal;
-    glassModal.material = {
-        .youngsModulus = glass.youngsModulus, .poissonRatio = glass.poissonRatio, .density = glass.density};
+    glassModal.material = glass;
     auto glassModes = volume::computeModes(p.tetMesh, glassModal);
     ASSERT_TRUE(glassModes.ok()) << e.name << ": " << glassModes.error().message;
     ASSERT_EQ(c->physics->frequenciesHz().size(), expected.size());
@@ -241,7 +239,8 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     // frame, units and material, are the adapted ones (frequencies to round-off; shapes to the 16 bits
     // they are stored in, up to sign, where a frequency is apart from its neighbours).
     volume::ModalOptions inQuery = db->parameters().entry.modal;
-    inQuery.material = {.youngsModulus = glass.youngsModulus, .poissonRatio = 0.3, .density = glass.density};
+    inQuery.material = glass;
+    inQuery.material.poissonRatio = 0.3;
     auto direct = volume::computeModes(p.tetMesh, inQuery);
     ASSERT_TRUE(direct.ok()) << e.name << ": " << direct.error().message;
     const Eigen::Index modes = p.modeShapes.cols();

@@ -29,7 +29,8 @@ TetMesh tetsOrDie(const core::TriangleMesh& surface, const TetrahedralizeOptions
 
 TEST(Fem, StiffnessAnnihilatesRigidMotionsAndMassIntegratesVolume) {
   const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(2.0, 1.0, 0.5)));
-  const FemMatrices fem = assembleFem(mesh, {.youngsModulus = 3.0, .poissonRatio = 0.25, .density = 2.0});
+  const FemMatrices fem =
+      assembleFem(mesh, {.name = "test", .density = 2.0, .youngsModulus = 3.0, .poissonRatio = 0.25});
   const auto n = static_cast<Eigen::Index>(mesh.nodeCount());
   // A translation, and an infinitesimal rotation about z: no strain, no force.
   Eigen::VectorXd translation(3 * n), rotation(3 * n);
@@ -89,7 +90,7 @@ TEST(Fem, BothOrdersIntegrateUniformStrainAndSecondMomentsExactly) {
     ASSERT_EQ(quadratic.nodes[i], mesh.nodes[i]);
   const core::MassProperties tets = core::computeTetMassProperties(mesh);
   const core::Mat3 covariance = core::covarianceFromInertia(tets.inertia);
-  const FemMaterial material{.youngsModulus = 3.0, .poissonRatio = 0.25, .density = 2.0};
+  const core::Material material{.name = "test", .density = 2.0, .youngsModulus = 3.0, .poissonRatio = 0.25};
   const double lambda = 3.0 * 0.25 / (1.25 * 0.5), mu = 3.0 / 2.5;
   // u = E x with E symmetric: uniform strain E, energy density λ (tr E)² / 2 + μ E:E.
   core::Mat3 strain;
@@ -115,7 +116,7 @@ TEST(Modal, QuadraticSparseAgreesWithDenseAndModesAreMOrthonormal) {
   const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.3, 0.9, 0.6)), {.maxVolumeFraction = 1.0 / 12.0});
   const QuadraticTetMesh quadratic = makeQuadratic(mesh);
   ASSERT_LT(quadratic.nodeCount(), 400u);
-  const ModalOptions options{.modes = 10, .material = {}, .order = ElementOrder::kQuadratic};
+  const ModalOptions options{.modes = 10, .material = core::unitMaterial(), .order = ElementOrder::kQuadratic};
   Result<core::ModalData> full = computeModes(quadratic, options);
   Result<core::ModalData> corners = computeModes(mesh, options);
   Result<core::ModalData> dense = computeModesDense(mesh, options);
@@ -147,7 +148,7 @@ TEST(Modal, QuadraticTetsDoNotLockInBending) {
   const TetMesh coarse = tetsOrDie(plate, {.maxVolumeFraction = 1.0 / 150.0});
   const TetMesh fine = tetsOrDie(plate, {.maxVolumeFraction = 1.0 / 1200.0});
   const auto first = [](const TetMesh& mesh, ElementOrder order) {
-    Result<core::ModalData> m = computeModes(mesh, {.modes = 4, .material = {}, .order = order});
+    Result<core::ModalData> m = computeModes(mesh, {.modes = 4, .material = core::unitMaterial(), .order = order});
     EXPECT_TRUE(m.ok()) << (m ? "" : m.error().message);
     return m ? std::sqrt(m->eigenvalues[0]) : 0.0;
   };
@@ -205,7 +206,7 @@ TEST(Modal, SeededLanczosAgreesWithTheDenseSolverForRandomSeeds) {
   std::mt19937 rng(11);
   std::normal_distribution<double> normal;
   for (ElementOrder order : {ElementOrder::kLinear, ElementOrder::kQuadratic}) {
-    const ModalOptions options{.modes = 6, .material = {.poissonRatio = 0.3}, .order = order};
+    const ModalOptions options{.modes = 6, .material = core::unitMaterial(0.3), .order = order};
     Result<core::ModalData> dense = computeModesDense(mesh, options);
     ASSERT_TRUE(dense.ok()) << dense.error().message;
     for (int trial = 0; trial < 2; ++trial) {
@@ -235,7 +236,7 @@ TEST(Modal, FreeFreeBeamOfLinearTetsMatchesEulerBernoulliWhenFine) {
   const TetMesh mesh =
       tetsOrDie(core::makeBox(Vec3(length, h, h)), {.maxRadiusEdgeRatio = 1.4, .maxVolumeFraction = 1e-4});
   Result<core::ModalData> modes = computeModes(
-      mesh, ModalOptions{.modes = 8, .material = {.poissonRatio = 0.3}, .order = ElementOrder::kLinear});
+      mesh, ModalOptions{.modes = 8, .material = core::unitMaterial(0.3), .order = ElementOrder::kLinear});
   ASSERT_TRUE(modes.ok()) << modes.error().message;
   const Eigen::VectorXd omega = modes->eigenvalues.cwiseSqrt();
   const auto eulerBernoulli = [&](double betaL) {
@@ -260,7 +261,7 @@ TEST(Modal, FreeFreeBeamAtTheDefaultQuadraticMeshingMatchesEulerBernoulli) {
   const double length = 1.0, h = 0.05;
   const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(length, h, h)), entryMeshing(ElementOrder::kQuadratic));
   Result<core::ModalData> modes =
-      computeModes(mesh, ModalOptions{.modes = 4, .material = {.poissonRatio = 0.3}});
+      computeModes(mesh, ModalOptions{.modes = 4, .material = core::unitMaterial(0.3)});
   ASSERT_TRUE(modes.ok()) << modes.error().message;
   const double expected = 4.730041 * 4.730041 * h / std::sqrt(12.0) / (length * length);
   for (int i = 0; i < 2; ++i) {  // bending in y and in z
@@ -283,7 +284,7 @@ TEST(Modal, DisconnectedSolidIsAnError) {
       v += offset;
     a.tets.push_back(tet);
   }
-  Result<core::ModalData> modes = computeModes(a, ModalOptions{.modes = 4, .material = {}});
+  Result<core::ModalData> modes = computeModes(a, ModalOptions{.modes = 4, .material = core::unitMaterial()});
   ASSERT_FALSE(modes.ok());
   EXPECT_NE(modes.error().message.find("rigid"), std::string::npos) << modes.error().message;
 }

@@ -71,7 +71,7 @@ TEST(Stretch, AgreesWithRitzOnTheAssembledStretchedMeshForRandomStretches) {
   ASSERT_EQ(s.modes.modeCount(), 8u);
   const core::StretchBasis basis = core::computeStretchBasis(s.mesh, s.modes);
   const auto n = static_cast<Eigen::Index>(s.mesh.nodeCount());
-  const FemMatrices original = assembleFem(s.mesh, {.poissonRatio = s.modes.poissonRatio});
+  const FemMatrices original = assembleFem(s.mesh, core::unitMaterial(s.modes.poissonRatio));
 
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> factor(0.6, 1.6);
@@ -83,7 +83,7 @@ TEST(Stretch, AgreesWithRitzOnTheAssembledStretchedMeshForRandomStretches) {
     ASSERT_TRUE(fast.ok()) << fast.error().message;
 
     const TetMesh mesh = stretched(s.mesh, a);
-    const FemMatrices fem = assembleFem(mesh, {.poissonRatio = s.modes.poissonRatio});
+    const FemMatrices fem = assembleFem(mesh, core::unitMaterial(s.modes.poissonRatio));
     // Each mode's x, y, z displacements as separate vectors, and the stretched body's rotations.
     Eigen::MatrixXd v = Eigen::MatrixXd::Zero(3 * n, 3 * 8 + 3);
     for (Eigen::Index r = 0; r < 8; ++r)

@@ -40,7 +40,7 @@ Result<CorrectedEntry> correctGeometry(const core::PhysicalData& entry, const co
   // The entry's modes on the same nodes are the seeds: the morph moved the nodes, not their numbering.
   start = Clock::now();
   ModalOptions unit = modal;
-  unit.material = {.youngsModulus = 1.0, .poissonRatio = modal.material.poissonRatio, .density = 1.0};
+  unit.material = core::unitMaterial(modal.material.poissonRatio);
   auto modes = computeModesFrom(out.physics.tetMesh, entry.modes.shapes, unit, &out.report.solves);
   if (!modes) return withContext(modes.error(), "correction: modes on the morphed tets");
   out.physics.modes = std::move(modes).value();

@@ -91,8 +91,7 @@ Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOpt
   entry.times.describe = clock.lap();
 
   ModalOptions modal = options.modal;
-  modal.material = {
-      .youngsModulus = 1.0, .poissonRatio = options.modal.material.poissonRatio, .density = 1.0};
+  modal.material = core::unitMaterial(options.modal.material.poissonRatio);
   auto modes = computeModes(entry.physics.tetMesh, modal);
   if (!modes) return withContext(modes.error(), "modes");
   entry.physics.modes = std::move(modes).value();

@@ -106,12 +106,12 @@ Eigen::MatrixXd rigidMotions(const std::vector<core::Vec3>& nodes, const SparseM
 }
 
 Status checkOptions(std::size_t nodeCount, const ModalOptions& options) {
-  const FemMaterial& m = options.material;
+  const core::Material& m = options.material;
   if (options.modes < 1) return Error{ErrorCode::kInvalidArgument, "at least one mode must be asked for"};
   if (!(m.youngsModulus > 0.0 && m.density > 0.0 && std::isfinite(m.youngsModulus) &&
         std::isfinite(m.density)))
     return Error{ErrorCode::kInvalidArgument, "Young's modulus and density must be finite and positive"};
-  if (!validPoissonRatio(m.poissonRatio))
+  if (!core::validPoissonRatio(m.poissonRatio))
     return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in [0, 0.5)"};
   if (3 * nodeCount < static_cast<std::size_t>(options.modes) + 6 + 2)
     return Error{ErrorCode::kInvalidArgument,
@@ -280,7 +280,7 @@ const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints() {
 namespace {
 
 /// Isotropic elasticity in Voigt order (xx, yy, zz, yz, xz, xy) with engineering shear strains.
-Eigen::Matrix<double, 6, 6> elasticity(const FemMaterial& material) {
+Eigen::Matrix<double, 6, 6> elasticity(const core::Material& material) {
   const double e = material.youngsModulus, nu = material.poissonRatio;
   Eigen::Matrix<double, 6, 6> d = Eigen::Matrix<double, 6, 6>::Zero();
   const double lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = e / (2.0 * (1.0 + nu));
@@ -393,7 +393,7 @@ class Assembler {
 
 }  // namespace
 
-FemMatrices assembleFem(const TetMesh& mesh, const FemMaterial& material) {
+FemMatrices assembleFem(const TetMesh& mesh, const core::Material& material) {
   const Eigen::Matrix<double, 6, 6> d = elasticity(material);
   // Consistent mass of a linear tet: ρV/20 · (1 + δ_ab) per axis.
   const Eigen::Matrix4d referenceMass = (Eigen::Matrix4d::Ones() + Eigen::Matrix4d::Identity()) / 20.0;
@@ -408,7 +408,7 @@ FemMatrices assembleFem(const TetMesh& mesh, const FemMaterial& material) {
   return std::move(assembler).finish();
 }
 
-FemMatrices assembleFem(const QuadraticTetMesh& mesh, const FemMaterial& material) {
+FemMatrices assembleFem(const QuadraticTetMesh& mesh, const core::Material& material) {
   const Eigen::Matrix<double, 6, 6> d = elasticity(material);
   Assembler<10> assembler(mesh.nodeCount(), mesh.tets);
   for (const QuadraticTetMesh::Tet& tet : mesh.tets) {

@@ -1,7 +1,8 @@
 #pragma once
-// Adaptation (paper §5, DESIGN.md "Adaptation"): a database entry's physical data, stored in its
-// canonical frame for unit volume, density and Young's modulus, carried to the query's frame, size and
-// material. And linking (paper eq. 7): the query's surface vertices embedded in the adapted tets.
+// Adaptation (paper §5; docs/architecture.md, "Adaptation and the stretch correction"): a database
+// entry's physical data, stored in its canonical frame for unit volume, density and Young's modulus, carried
+// to the query's frame, size and material. And linking (paper eq. 7): the query's surface vertices embedded
+// in the adapted tets.
 #include <span>
 #include <string>
 #include <string_view>
@@ -10,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include <shapedb/core/mass_properties.h>
+#include <shapedb/core/material.h>
 #include <shapedb/core/normalize.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
@@ -18,23 +20,6 @@
 #include <shapedb/core/types.h>
 
 namespace shapedb::core {
-
-/// An isotropic linear elastic material, SI units.
-struct Material {
-  std::string name;            ///< a preset's name, or "custom"
-  double density = 0.0;        ///< ρ, kg/m³
-  double youngsModulus = 0.0;  ///< E, Pa
-  double poissonRatio = 0.0;   ///< ν, in (−1, 0.5)
-};
-
-/// steel, aluminium, glass, wood, rubber, concrete: textbook room-temperature values (wood: along the
-/// grain, as an isotropic stand-in; rubber: small-strain modulus).
-std::span<const Material> materialPresets();
-/// A preset by name (case-insensitive; "aluminum" also accepted). Errors: kInvalidArgument naming the
-/// presets.
-Result<Material> materialPreset(std::string_view name);
-/// Errors: kInvalidArgument if ρ or E is not finite and positive or ν is outside (−1, 0.5).
-Status validateMaterial(const Material& material);
 
 /// Where an entry's canonical frame lands in the query's frame: p = translation + scale · rotation · e.
 /// For a query normalized by T (p' = s Rᵀ (p − c)) and matched in orientation O (the entry's canonical

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
+#include <shapedb/core/material.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
 
@@ -22,21 +23,9 @@ struct FemMatrices {
   Eigen::SparseMatrix<double> mass;
 };
 
-/// Material of the FEM: Young's modulus E (Pa), Poisson ratio ν, density ρ (kg/m³). The database uses
-/// E = ρ = 1: frequencies then scale as √(E/ρ) (paper §5).
-struct FemMaterial {
-  double youngsModulus = 1.0;
-  double poissonRatio = 0.3;
-  double density = 1.0;
-};
-
-/// The Poisson ratios the FEM takes, [0, 0.5) (auxetic materials are not modelled).
-constexpr bool validPoissonRatio(double nu) {
-  return nu >= 0.0 && nu < 0.5;
-}
-
-/// Assembles K and M. Preconditions: core::validateTetMesh(mesh) passed; 0 ≤ ν < 0.5.
-FemMatrices assembleFem(const core::TetMesh& mesh, const FemMaterial& material = {});
+/// Assembles K and M for `material` (the database uses core::unitMaterial(): frequencies then scale as
+/// √(E/ρ), paper §5). Preconditions: core::validateTetMesh(mesh) passed; core::validPoissonRatio(ν).
+FemMatrices assembleFem(const core::TetMesh& mesh, const core::Material& material = core::unitMaterial());
 
 /// Quadratic (10-node) tets on a linear tet mesh, for bending: constant-strain tets lock, a plate two or
 /// three tets thick comes out tens of per cent too stiff, while quadratic ones on the same mesh are within
@@ -68,7 +57,7 @@ const Eigen::Matrix<double, 10, 10>& quadraticReferenceMass();
 const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints();
 
 /// K and M of the quadratic tets (stiffness by the exact four-point rule, consistent mass exact).
-FemMatrices assembleFem(const QuadraticTetMesh& mesh, const FemMaterial& material = {});
+FemMatrices assembleFem(const QuadraticTetMesh& mesh, const core::Material& material = core::unitMaterial());
 
 /// Which elements the modal analysis uses.
 enum class ElementOrder : std::uint8_t { kLinear = 1, kQuadratic = 2 };
@@ -79,7 +68,7 @@ std::optional<ElementOrder> parseElementOrder(std::string_view name);
 /// How many modes, for which material, on which elements.
 struct ModalOptions {
   int modes = 20;  ///< non-rigid modes wanted, ≥ 1
-  FemMaterial material;
+  core::Material material = core::unitMaterial();
   /// Quadratic (the default): the modes of the 10-node tets on the given mesh, their shapes reported at
   /// its nodes (the corners; the mid-edge values are dropped). Linear: constant-strain tets, which lock in
   /// bending (a plate two or three tets thick rings tens of per cent high) unless the mesh is very fine.
