@@ -47,11 +47,8 @@ Result<std::vector<io::NamedMesh>> loadShapes(const BenchCommandOptions& o) {
   }
   Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.load, o.fracture);
   if (!pieces) return pieces.error();
-  for (std::size_t i = 0; i < pieces->fragments.size(); ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, "fragment-%03zu", i);
-    shapes.push_back({name, o.fractureMesh, std::move(pieces->fragments[i])});
-  }
+  for (std::size_t i = 0; i < pieces->fragments.size(); ++i)
+    shapes.push_back({volume::fragmentName(i), o.fractureMesh, std::move(pieces->fragments[i])});
   return shapes;
 }
 

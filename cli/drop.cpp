@@ -88,7 +88,7 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
     }
     for (std::size_t i = 0; i < pieces->fragments.size(); ++i) {
       meshes.push_back(std::move(pieces->fragments[i]));
-      names.push_back("fragment-" + std::to_string(i));
+      names.push_back(volume::fragmentName(i));
     }
   } else {
     for (const std::string& file : o.meshes) {
@@ -173,10 +173,7 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
     core::TriangleMesh backdrop = core::makeBox({size.x() + 2 * margin, 0.002, o.height + size.z() + margin});
     for (core::Vec3& p : backdrop.vertices)
       p += core::Vec3(middle.x(), hi.y() + margin, 0.5 * (o.height + size.z() + margin));
-    const auto offset = static_cast<std::uint32_t>(stage.vertices.size());
-    stage.vertices.insert(stage.vertices.end(), backdrop.vertices.begin(), backdrop.vertices.end());
-    for (auto t : backdrop.triangles)
-      stage.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    core::append(stage, backdrop);
     std::vector<core::TriangleMesh> surfaces;
     for (std::size_t b = 0; b < bodies.size(); ++b)
       surfaces.push_back(meshes[source[b]]);

@@ -37,8 +37,7 @@ int runFracture(const FractureCommandOptions& o) {
     return kExitInputError;
   }
   for (std::size_t i = 0; i < pieces->fragments.size(); ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, "fragment-%03zu.%s", i, o.format.c_str());
+    const std::string name = volume::fragmentName(i) + "." + o.format;
     if (Status st = io::saveMesh(pieces->fragments[i], std::filesystem::path(o.out) / name); !st) {
       printError(st.error().message);
       return kExitInputError;

@@ -133,7 +133,7 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
       scene = pieces.error();
     } else {
       for (std::size_t i = 0; i < pieces->fragments.size(); ++i)
-        scene->push_back({"fragment-" + std::to_string(i), std::move(pieces->fragments[i])});
+        scene->push_back({volume::fragmentName(i), std::move(pieces->fragments[i])});
       std::fprintf(stderr, "haptic: %s broken into %zu fragments\n", o.fractureMesh.c_str(), scene->size());
     }
   }

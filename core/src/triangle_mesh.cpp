@@ -25,6 +25,14 @@ double computeSurfaceArea(const TriangleMesh& mesh) {
   return 0.5 * twiceArea;
 }
 
+void append(TriangleMesh& into, const TriangleMesh& part) {
+  const auto offset = static_cast<std::uint32_t>(into.vertices.size());
+  into.vertices.insert(into.vertices.end(), part.vertices.begin(), part.vertices.end());
+  into.triangles.reserve(into.triangles.size() + part.triangles.size());
+  for (const auto& t : part.triangles)
+    into.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+}
+
 TriangleMesh transformed(const TriangleMesh& mesh, const Mat4& dstFromSrc) {
   TriangleMesh out;
   out.vertices.reserve(mesh.vertices.size());

@@ -74,10 +74,7 @@ TriangleMesh reversed(TriangleMesh mesh, std::size_t count) {
 
 TriangleMesh merged(const TriangleMesh& a, const TriangleMesh& b) {
   TriangleMesh out = a;
-  const auto offset = static_cast<std::uint32_t>(a.vertices.size());
-  out.vertices.insert(out.vertices.end(), b.vertices.begin(), b.vertices.end());
-  for (auto t : b.triangles)
-    out.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  core::append(out, b);
   return out;
 }
 

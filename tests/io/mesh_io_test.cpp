@@ -303,11 +303,10 @@ TEST(MeshIo, AnOpenSoupIsWeldedClosedAndAClosedSurfaceIsLeftAlone) {
   // Two closed boxes that share an edge's positions (an assembly exported as one file): each is closed
   // as read, so nothing is welded into a non-manifold edge.
   TriangleMesh pair = box;
-  const auto offset = static_cast<std::uint32_t>(pair.vertices.size());
-  for (const Vec3& p : box.vertices)
-    pair.vertices.push_back(p + Vec3(0.3, 0.2, 0.0));
-  for (const auto& t : box.triangles)
-    pair.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  TriangleMesh moved = box;
+  for (Vec3& p : moved.vertices)
+    p += Vec3(0.3, 0.2, 0.0);
+  core::append(pair, moved);
   test::writeFile(dir / "pair.obj", test::objText(pair));
   const LoadedMesh asIs = mustLoad(dir / "pair.obj");
   EXPECT_EQ(asIs.verticesWelded, 0u);

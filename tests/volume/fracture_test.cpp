@@ -75,6 +75,8 @@ TEST(Fracture, AMeshFarFromTheOriginBreaksAsAtTheOrigin) {
   ASSERT_TRUE(here.ok()) << here.error().message;
   EXPECT_EQ(here->openDropped, 0u);
   EXPECT_EQ(here->resolution, 64);  // as given
+  EXPECT_EQ(fragmentName(7), "fragment-007");
+  EXPECT_EQ(fragmentName(1234), "fragment-1234");
   for (const double offset : {1e3, 1e6}) {
     SCOPED_TRACE(offset);
     const Vec3 shift(offset, -0.7 * offset, 0.3 * offset);
@@ -189,12 +191,10 @@ TEST(Fracture, FragmentsAreSimplifiedAndTetGenFillsThemExactly) {
 TEST(Fracture, ACellThatHoldsTwoSeparatePartsGivesTwoFragments) {
   // Two boxes apart, one mesh: the single cell covers both, and segmentation must split them.
   core::TriangleMesh pair = core::makeBox({0.2, 0.2, 0.2});
-  const core::TriangleMesh other = core::makeBox({0.1, 0.1, 0.1});
-  const auto offset = static_cast<std::uint32_t>(pair.vertices.size());
-  for (const core::Vec3& p : other.vertices)
-    pair.vertices.push_back(p + core::Vec3(0.5, 0.0, 0.0));
-  for (const auto& t : other.triangles)
-    pair.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  core::TriangleMesh other = core::makeBox({0.1, 0.1, 0.1});
+  for (core::Vec3& p : other.vertices)
+    p += core::Vec3(0.5, 0.0, 0.0);
+  core::append(pair, other);
   FractureOptions options;
   options.pieces = 1;
   options.resolution = 96;

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 
@@ -140,6 +141,12 @@ std::pair<TriangleMesh, Meshing> fragmentSurface(const openvdb::FloatGrid& grid,
 }
 
 }  // namespace
+
+std::string fragmentName(std::size_t index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "fragment-%03zu", index);
+  return name;
+}
 
 int automaticResolution(const TriangleMesh& mesh, int pieces) {
   constexpr double kBase = 128.0, kMax = 1024.0, kAcrossThickness = 6.0, kAcrossFragment = 16.0;

@@ -40,6 +40,10 @@ double computeSurfaceArea(const TriangleMesh& mesh);
 /// keeps facing outward.
 TriangleMesh transformed(const TriangleMesh& mesh, const Mat4& dstFromSrc);
 
+/// `part`'s vertices and triangles added to `into` (its indices shifted past into's vertices): one mesh
+/// of several surfaces, nothing welded.
+void append(TriangleMesh& into, const TriangleMesh& part);
+
 /// The mesh with every triangle's winding reversed (an inside-out mesh turned right side out).
 TriangleMesh flipped(const TriangleMesh& mesh);
 

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <shapedb/core/result.h>
@@ -58,6 +59,10 @@ struct FractureResult {
 /// across the solid's mean thickness 2V/A and 16 across a fragment's mean size (V/pieces)^(1/3), at most
 /// 1,024. A 3 mm tray 356 mm wide gets 672; a bottle in 200 pieces 296; a pebble in 20 pieces 128.
 int automaticResolution(const core::TriangleMesh& mesh, int pieces);
+
+/// "fragment-000", "fragment-001", ...: the name of fracture's index-th fragment, wherever one is
+/// written or shown (files, scenes, reports).
+std::string fragmentName(std::size_t index);
 
 /// Errors: kInvalidArgument for options out of range; validateMesh's; kNotClosed (and the other
 /// topology errors) for a mesh that does not enclose a volume.
