@@ -274,8 +274,8 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
   const volume::EntryOptions options = volume::withElements({}, volume::ElementOrder::kQuadratic);
   auto tets = volume::tetrahedralize(surface, options.tetgen);
   ASSERT_TRUE(tets.ok()) << tets.error().message;
-  auto direct =
-      volume::computeModes(*tets, {.modes = 4, .material = core::unitMaterial(), .order = volume::ElementOrder::kQuadratic});
+  auto direct = volume::computeModes(
+      *tets, {.modes = 4, .material = core::unitMaterial(), .order = volume::ElementOrder::kQuadratic});
   ASSERT_TRUE(direct.ok()) << direct.error().message;
   ASSERT_EQ(physics["frequencies_hz"].size(), 4u);
   for (int i = 0; i < 4; ++i)

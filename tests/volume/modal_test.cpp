@@ -116,7 +116,8 @@ TEST(Modal, QuadraticSparseAgreesWithDenseAndModesAreMOrthonormal) {
   const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.3, 0.9, 0.6)), {.maxVolumeFraction = 1.0 / 12.0});
   const QuadraticTetMesh quadratic = makeQuadratic(mesh);
   ASSERT_LT(quadratic.nodeCount(), 400u);
-  const ModalOptions options{.modes = 10, .material = core::unitMaterial(), .order = ElementOrder::kQuadratic};
+  const ModalOptions options{
+      .modes = 10, .material = core::unitMaterial(), .order = ElementOrder::kQuadratic};
   Result<core::ModalData> full = computeModes(quadratic, options);
   Result<core::ModalData> corners = computeModes(mesh, options);
   Result<core::ModalData> dense = computeModesDense(mesh, options);
@@ -148,7 +149,8 @@ TEST(Modal, QuadraticTetsDoNotLockInBending) {
   const TetMesh coarse = tetsOrDie(plate, {.maxVolumeFraction = 1.0 / 150.0});
   const TetMesh fine = tetsOrDie(plate, {.maxVolumeFraction = 1.0 / 1200.0});
   const auto first = [](const TetMesh& mesh, ElementOrder order) {
-    Result<core::ModalData> m = computeModes(mesh, {.modes = 4, .material = core::unitMaterial(), .order = order});
+    Result<core::ModalData> m =
+        computeModes(mesh, {.modes = 4, .material = core::unitMaterial(), .order = order});
     EXPECT_TRUE(m.ok()) << (m ? "" : m.error().message);
     return m ? std::sqrt(m->eigenvalues[0]) : 0.0;
   };
