@@ -54,6 +54,9 @@ void addFractureFlags(CLI::App& app, volume::FractureOptions& options);
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);
 
+/// The flag that would get past a refusal of a mesh, as "; --flag ..." to append to its message, or "".
+std::string flagHint(const Error& error);
+
 /// Adds --units, --scale and --weld-tolerance to `app`.
 void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags);
 

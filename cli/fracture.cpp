@@ -71,7 +71,11 @@ Result<volume::FractureResult> fractureMeshFile(const std::string& path, const M
   Result<io::LoadedMesh> loaded = loadMeshFile(path, load);
   if (!loaded) return loaded.error();
   Result<volume::FractureResult> pieces = volume::fracture(loaded->mesh, options);
-  if (!pieces) return withContext(pieces.error(), path);
+  if (!pieces) {
+    Error error = withContext(pieces.error(), path);
+    error.message += flagHint(pieces.error());
+    return error;
+  }
   return pieces;
 }
 

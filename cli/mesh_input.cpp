@@ -6,6 +6,12 @@
 
 namespace shapedb::cli {
 
+std::string flagHint(const Error& error) {
+  if (error.code == ErrorCode::kNotClosed || error.code == ErrorCode::kNonManifold)
+    return "; if its vertices only nearly coincide, --weld-tolerance F (say 1e-6) welds them";
+  return "";
+}
+
 void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
   CLI::Option* units =
       app.add_option_function<std::string>(

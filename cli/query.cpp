@@ -281,7 +281,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
     }
     auto result = db->query(loaded->mesh, options);
     if (!result) {
-      printError(file + ": " + result.error().message);
+      printError(file + ": " + result.error().message + flagHint(result.error()));
       status = kExitInputError;
       continue;
     }

@@ -62,7 +62,7 @@ int runSound(const SoundCommandOptions& o, const CLI::App& app) {
   query.fidelity = false;
   Result<io::QueryResult> r = db->query(loaded->mesh, query);
   if (!r) {
-    printError(o.mesh + ": " + r.error().message);
+    printError(o.mesh + ": " + r.error().message + flagHint(r.error()));
     return kExitInputError;
   }
   if (r->matches.empty() || !r->physics) {
