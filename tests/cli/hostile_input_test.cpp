@@ -55,17 +55,6 @@ TriangleMesh scaled(TriangleMesh mesh, double s) {
 }
 
 /// A box whose faces share no vertex: every corner repeated per triangle, as a triangle soup is.
-TriangleMesh soup(const TriangleMesh& mesh) {
-  TriangleMesh out;
-  for (const auto& t : mesh.triangles) {
-    const auto base = static_cast<std::uint32_t>(out.vertices.size());
-    for (auto v : t)
-      out.vertices.push_back(mesh.vertices[v]);
-    out.triangles.push_back({base, base + 1, base + 2});
-  }
-  return out;
-}
-
 TriangleMesh reversed(TriangleMesh mesh, std::size_t count) {
   for (std::size_t i = 0; i < count && i < mesh.triangles.size(); ++i)
     std::swap(mesh.triangles[i][1], mesh.triangles[i][2]);
@@ -192,7 +181,7 @@ std::vector<Case> corpus() {
        },
        "not closed (4 boundary edges); if its vertices only nearly coincide, --weld-tolerance"},
       {"single_triangle.obj", [] { return "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; }, "not closed"},
-      {"coincident_vertices_soup.obj", [=] { return test::objText(soup(box)); }, "",
+      {"coincident_vertices_soup.obj", [=] { return test::objText(test::soupOf(box)); }, "",
        massNear(0.3 * 0.2 * 0.1)},  // welded at load, with a warning
       {"fin_on_a_tet.obj", [] { return kTet + "v 1 1 1\n" + kTetFaces + "f 1 2 5\n"; }, "not closed"},
       {"two_tets_sharing_an_edge.obj",

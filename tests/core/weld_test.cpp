@@ -9,24 +9,14 @@
 #include <shapedb/core/topology.h>
 #include <shapedb/core/weld.h>
 
+#include "support/mesh_files.h"
+
 namespace shapedb::core {
 namespace {
 
-/// Every triangle with its own three corners, as STL files hold surfaces.
-TriangleMesh soupOf(const TriangleMesh& mesh) {
-  TriangleMesh soup;
-  for (const auto& t : mesh.triangles) {
-    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
-    for (const std::uint32_t v : t)
-      soup.vertices.push_back(mesh.vertices[v]);
-    soup.triangles.push_back({base, base + 1, base + 2});
-  }
-  return soup;
-}
-
 TEST(Weld, ASoupOfAClosedSurfaceBecomesThatSurface) {
   const TriangleMesh box = makeBox({0.3, 0.2, 0.1});
-  TriangleMesh soup = soupOf(box);
+  TriangleMesh soup = test::soupOf(box);
   ASSERT_FALSE(analyzeTopology(soup).isClosed());
   const WeldReport report = weldVertices(soup);
   EXPECT_EQ(soup.vertices.size(), box.vertices.size());
@@ -39,7 +29,7 @@ TEST(Weld, ASoupOfAClosedSurfaceBecomesThatSurface) {
 }
 
 TEST(Weld, WithinAToleranceNearbyCornersMergeAndSliversGo) {
-  TriangleMesh soup = soupOf(makeBox({0.3, 0.2, 0.1}));
+  TriangleMesh soup = test::soupOf(makeBox({0.3, 0.2, 0.1}));
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> jitter(-1e-7, 1e-7);
   for (Vec3& p : soup.vertices)

@@ -284,13 +284,7 @@ TEST(MeshIo, AnOpenSoupIsWeldedClosedAndAClosedSurfaceIsLeftAlone) {
   const TriangleMesh box = core::makeBox({0.3, 0.2, 0.1});
   // As binary STL writers store surfaces: three corners per triangle, nothing shared. (OpenMesh's STL
   // reader merges exactly equal corners itself, so the soup goes through OBJ.)
-  TriangleMesh soup;
-  for (const auto& t : box.triangles) {
-    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
-    for (const std::uint32_t v : t)
-      soup.vertices.push_back(box.vertices[v]);
-    soup.triangles.push_back({base, base + 1, base + 2});
-  }
+  const TriangleMesh soup = test::soupOf(box);
   test::writeFile(dir / "soup.obj", test::objText(soup));
   const LoadedMesh welded = mustLoad(dir / "soup.obj");
   EXPECT_TRUE(welded.topology.isClosed());

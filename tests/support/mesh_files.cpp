@@ -4,6 +4,17 @@
 
 namespace shapedb::test {
 
+core::TriangleMesh soupOf(const core::TriangleMesh& mesh) {
+  core::TriangleMesh out;
+  for (const auto& t : mesh.triangles) {
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
+    for (const std::uint32_t v : t)
+      out.vertices.push_back(mesh.vertices[v]);
+    out.triangles.push_back({base, base + 1, base + 2});
+  }
+  return out;
+}
+
 std::string objText(const core::TriangleMesh& mesh) {
   std::ostringstream out;
   out.precision(17);

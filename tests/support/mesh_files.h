@@ -12,6 +12,9 @@ namespace shapedb::test {
 
 /// OBJ text: "v x y z" lines (17 digits), then "f a b c" lines (1-based).
 std::string objText(const core::TriangleMesh& mesh);
+
+/// The mesh as a triangle soup: every triangle with its own three corners, as STL files hold surfaces.
+core::TriangleMesh soupOf(const core::TriangleMesh& mesh);
 /// OFF text (17 digits).
 std::string offText(const core::TriangleMesh& mesh);
 /// ASCII STL (9 digits: single precision, as STL stores).
