@@ -153,11 +153,7 @@ int automaticResolution(const TriangleMesh& mesh, int pieces) {
   const core::Bounds bounds = core::computeBounds(mesh);
   const double longest = (bounds.max - bounds.min).maxCoeff();
   const double volume = std::abs(signedVolume(mesh));
-  double area = 0.0;
-  for (const auto& t : mesh.triangles)
-    area +=
-        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm();
-  area *= 0.5;
+  const double area = core::computeSurfaceArea(mesh);
   if (!(longest > 0.0 && volume > 0.0 && area > 0.0)) return static_cast<int>(kBase);
   const double thickness = 2.0 * volume / area;
   const double fragment = std::cbrt(volume / std::max(pieces, 1));
