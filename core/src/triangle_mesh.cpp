@@ -25,6 +25,15 @@ double computeSurfaceArea(const TriangleMesh& mesh) {
   return 0.5 * twiceArea;
 }
 
+double computeSignedVolume(const TriangleMesh& mesh) {
+  if (mesh.vertices.empty()) return 0.0;
+  const Vec3 o = mesh.vertices.front();
+  double six = 0.0;
+  for (const auto& t : mesh.triangles)
+    six += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
+  return six / 6.0;
+}
+
 void append(TriangleMesh& into, const TriangleMesh& part) {
   const auto offset = static_cast<std::uint32_t>(into.vertices.size());
   into.vertices.insert(into.vertices.end(), part.vertices.begin(), part.vertices.end());

@@ -112,16 +112,6 @@ Result<detail::RawPolygons> readStl(const std::filesystem::path& path) {
   return std::move(importer.raw);
 }
 
-/// Signed volume of a closed surface (divergence theorem), about its first vertex so that a mesh far from
-/// the origin loses no digits.
-double signedVolume(const core::TriangleMesh& mesh) {
-  const core::Vec3 o = mesh.vertices.front();
-  double six = 0.0;
-  for (const auto& t : mesh.triangles)
-    six += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
-  return six / 6.0;
-}
-
 // OpenMesh's writers need one of its own kernels; double-precision points so nothing is lost before
 // the writer formats them.
 struct DoubleTraits : OpenMesh::DefaultTraits {
@@ -221,7 +211,7 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
     }
   }
   if (out.topology.isClosed() && out.topology.isConsistentlyOriented()) {
-    out.signedVolumeAsRead = signedVolume(out.mesh);
+    out.signedVolumeAsRead = core::computeSignedVolume(out.mesh);
     if (options.orientOutward && out.signedVolumeAsRead < 0.0) {
       for (auto& t : out.mesh.triangles)
         std::swap(t[1], t[2]);

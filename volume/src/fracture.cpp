@@ -9,17 +9,14 @@
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetUtil.h>
-#include <openvdb/tools/MeshToVolume.h>
-#include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/fracture.h>
 #include <shapedb/volume/openvdb_runtime.h>
-#include <shapedb/volume/simplify.h>
 
+#include "level_set.h"
 #include "polyhedron.h"
 
 namespace shapedb::volume {
@@ -29,116 +26,9 @@ using core::Vec3;
 
 namespace {
 
-constexpr float kHalfWidth = 3.0f;     ///< narrow band, voxels, for the solid and every cutter alike
+using detail::Meshing;
+
 constexpr double kFrameMargin = 16.0;  ///< voxels between the local frame's origin and the mesh's bounds
-
-openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::Transform& transform) {
-  std::vector<openvdb::Vec3s> points;
-  points.reserve(mesh.vertices.size());
-  for (const Vec3& p : mesh.vertices)
-    points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-  std::vector<openvdb::Vec3I> triangles;
-  triangles.reserve(mesh.triangles.size());
-  for (const auto& t : mesh.triangles)
-    triangles.emplace_back(t[0], t[1], t[2]);
-  return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(transform, points, triangles, kHalfWidth);
-}
-
-/// Signed volume of a closed surface (divergence theorem), about its first vertex: about the origin, a
-/// mesh a kilometre away would lose every digit of it.
-double signedVolume(const TriangleMesh& mesh) {
-  if (mesh.vertices.empty()) return 0.0;
-  const Vec3 o = mesh.vertices.front();
-  double six = 0.0;
-  for (const auto& t : mesh.triangles)
-    six += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
-  return six / 6.0;
-}
-
-/// The crossing of a fragment's level set at `isovalue` (m), as an outward-wound triangle mesh (quads
-/// split).
-TriangleMesh meshOf(const openvdb::FloatGrid& grid, double isovalue) {
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> triangles;
-  std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(grid, points, triangles, quads, isovalue, 0.0);
-  TriangleMesh mesh;
-  mesh.vertices.reserve(points.size());
-  for (const openvdb::Vec3s& p : points)
-    mesh.vertices.emplace_back(p.x(), p.y(), p.z());
-  for (const openvdb::Vec3I& t : triangles)
-    mesh.triangles.push_back({t[0], t[1], t[2]});
-  for (const openvdb::Vec4I& q : quads) {
-    mesh.triangles.push_back({q[0], q[1], q[2]});
-    mesh.triangles.push_back({q[0], q[2], q[3]});
-  }
-  if (signedVolume(mesh) < 0.0)
-    for (auto& t : mesh.triangles)
-      std::swap(t[1], t[2]);
-  return mesh;
-}
-
-bool closedSolid(const TriangleMesh& mesh) {
-  return !mesh.triangles.empty() && core::validateMesh(mesh).ok() &&
-         core::requireClosedOriented(core::analyzeTopology(mesh)).ok();
-}
-
-/// How a fragment's surface came out of its level set.
-enum class Meshing { kClosed, kRemeshed, kOpen };
-
-/// A fragment's closed surface: the zero crossing, simplified. Marching cubes can leave a non-manifold
-/// edge or vertex where two sheets of the level set touch within a voxel (a thin wall, a cut grazing a
-/// surface); a crossing slightly inside or outside the zero level separates them, so those are tried
-/// next, a hundredth of a voxel at a time (the surface moves by that much, far under the simplification's
-/// own error). A simplification that does not stay closed is not used.
-std::pair<TriangleMesh, Meshing> fragmentSurface(const openvdb::FloatGrid& grid, double voxelSize,
-                                                 const FractureOptions& options) {
-  static constexpr double kIsovalues[] = {0.0, -0.01, 0.01, -0.03, 0.03, -0.1, 0.1};
-  TriangleMesh raw;
-  Meshing meshing = Meshing::kOpen;
-  for (const double isovalue : kIsovalues) {
-    raw = meshOf(grid, isovalue * voxelSize);
-    if (raw.triangles.empty() || closedSolid(raw)) {
-      meshing = isovalue == 0.0 ? Meshing::kClosed : Meshing::kRemeshed;
-      break;
-    }
-  }
-  if (meshing == Meshing::kOpen) return {meshOf(grid, 0.0), meshing};
-  if (options.maxTriangles == 0 || raw.triangles.size() <= options.maxTriangles)
-    return {std::move(raw), meshing};
-  // Simplified about the fragment's own centre (the decimater's quadrics are computed in coordinates).
-  // Its quadric bound holds each collapse near the planes it has merged, not the faces it leaves: on thin
-  // plates whole strips of a fragment's rim came out bevelled several times the bound deep, and a few per
-  // cent of its volume gone. So every simplified face is checked at its centroid against the raw surface;
-  // one farther than twice the bound has the simplification done again with half the error, and at the
-  // end the raw surface stands.
-  const core::Bounds box = core::computeBounds(raw);
-  const Vec3 centre = 0.5 * (box.min + box.max);
-  TriangleMesh centred = raw;
-  for (Vec3& p : centred.vertices)
-    p -= centre;
-  const core::ClosestPointTree rawSurface(centred);
-  const auto faithful = [&](const TriangleMesh& simpler, double maxError) {
-    const double limitSq = 4.0 * maxError * maxError;
-    for (const auto& t : simpler.triangles) {
-      const Vec3 c = (simpler.vertices[t[0]] + simpler.vertices[t[1]] + simpler.vertices[t[2]]) / 3.0;
-      if (rawSurface.closest(c).closest.squaredDistance > limitSq) return false;
-    }
-    return true;
-  };
-  SimplifyOptions simplifyOptions;
-  simplifyOptions.maxTriangles = options.maxTriangles;
-  for (double error = options.simplifyError; error >= options.simplifyError / 4.0; error /= 2.0) {
-    simplifyOptions.maxError = error * voxelSize;
-    Result<TriangleMesh> simpler = simplify(centred, simplifyOptions);
-    if (!simpler.ok() || !closedSolid(*simpler)) break;
-    if (!faithful(*simpler, simplifyOptions.maxError)) continue;
-    for (Vec3& p : simpler->vertices)
-      p += centre;
-    return {std::move(simpler).value(), meshing};
-  }
-  return {std::move(raw), meshing};
-}
 
 }  // namespace
 
@@ -152,7 +42,7 @@ int automaticResolution(const TriangleMesh& mesh, int pieces) {
   constexpr double kBase = 128.0, kMax = 1024.0, kAcrossThickness = 6.0, kAcrossFragment = 16.0;
   const core::Bounds bounds = core::computeBounds(mesh);
   const double longest = (bounds.max - bounds.min).maxCoeff();
-  const double volume = std::abs(signedVolume(mesh));
+  const double volume = std::abs(core::computeSignedVolume(mesh));
   const double area = core::computeSurfaceArea(mesh);
   if (!(longest > 0.0 && volume > 0.0 && area > 0.0)) return static_cast<int>(kBase);
   const double thickness = 2.0 * volume / area;
@@ -177,7 +67,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
     return Error{ErrorCode::kInvalidArgument, "the crumb threshold must be a fraction in [0, 1)"};
   if (Status st = core::validateMesh(mesh); !st) return st.error();
   if (Status st = core::requireClosedOriented(core::analyzeTopology(mesh)); !st) return st.error();
-  const double volume = signedVolume(mesh);
+  const double volume = core::computeSignedVolume(mesh);
   if (!(volume > 0.0))
     return Error{ErrorCode::kInsideOut,
                  "the surface encloses a negative or zero volume (faces wound inward?)"};
@@ -202,7 +92,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   const core::Bounds bounds = core::computeBounds(local);
   const openvdb::math::Transform::Ptr transform =
       openvdb::math::Transform::createLinearTransform(result.voxelSize);
-  openvdb::FloatGrid::Ptr solid = levelSet(local, *transform);
+  openvdb::FloatGrid::Ptr solid = detail::levelSet(local, *transform);
 
   // Seeds: uniform in the bounding box, kept where the level set says the point is inside.
   std::mt19937_64 rng(options.seed);
@@ -226,7 +116,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   // what tools::LevelSetFracture does cutter by cutter, without its cost: it re-segments every fragment
   // made so far at each cut, quadratic in the pieces (200 pieces took minutes), and it drops a fragment
   // whose cutter leaves no residual (a cell that holds the whole solid).
-  const Vec3 margin = Vec3::Constant((kHalfWidth + 2.0) * result.voxelSize);
+  const Vec3 margin = Vec3::Constant((detail::kLevelSetHalfWidth + 2.0) * result.voxelSize);
   std::vector<std::vector<openvdb::FloatGrid::Ptr>> cellGrids(seeds.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seeds.size(), 1), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -238,7 +128,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
       const Vec3 lo = cellBounds.min - margin, hi = cellBounds.max + margin;
       const openvdb::FloatGrid::Ptr clipped =
           openvdb::tools::clip(*solid, openvdb::BBoxd({lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}));
-      const openvdb::FloatGrid::Ptr cutter = levelSet(cutterMesh, *transform);
+      const openvdb::FloatGrid::Ptr cutter = detail::levelSet(cutterMesh, *transform);
       const openvdb::FloatGrid::Ptr piece = openvdb::tools::csgIntersectionCopy(*clipped, *cutter);
       if (piece->tree().empty()) continue;
       openvdb::tools::segmentSDF(*piece, cellGrids[i]);
@@ -250,13 +140,15 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
 
   std::vector<std::pair<TriangleMesh, Meshing>> surfaces(grids.size());
   tbb::parallel_for(std::size_t{0}, grids.size(), [&](std::size_t i) {
-    surfaces[i] = fragmentSurface(*grids[i], result.voxelSize, options);
+    surfaces[i] =
+        detail::closedSurface(*grids[i], result.voxelSize,
+                              {.maxTriangles = options.maxTriangles, .simplifyError = options.simplifyError});
   });
 
   std::vector<std::pair<double, TriangleMesh>> pieces;
   for (auto& [piece, meshing] : surfaces) {
     if (piece.triangles.empty()) continue;
-    const double v = signedVolume(piece);
+    const double v = core::computeSignedVolume(piece);
     if (meshing == Meshing::kOpen) {
       // No crossing near the zero level closed: never seen, and not passed on as a solid.
       ++result.openDropped;

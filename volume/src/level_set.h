@@ -1,0 +1,47 @@
+#pragma once
+
+// Closed surfaces through OpenVDB level sets: a triangle mesh to a narrow-band signed distance grid, and a
+// grid's zero crossing back to a closed, simplified triangle mesh. Shared by fracture and the families
+// built by constructive solid geometry. Internal to volume (it names OpenVDB types).
+
+#include <cstddef>
+#include <utility>
+
+#include <openvdb/openvdb.h>
+
+#include <shapedb/core/triangle_mesh.h>
+
+namespace shapedb::volume::detail {
+
+/// Narrow band half-width, voxels, of every level set made here.
+inline constexpr float kLevelSetHalfWidth = 3.0f;
+
+/// The level set of a closed, outward-wound surface in `transform`'s voxels (its points go through
+/// single precision: the caller keeps them near the origin of a local frame).
+openvdb::FloatGrid::Ptr levelSet(const core::TriangleMesh& mesh, const openvdb::math::Transform& transform);
+
+/// How a surface came out of its level set.
+enum class Meshing {
+  kClosed,    ///< the zero crossing is a closed manifold
+  kRemeshed,  ///< a crossing a hundredth to a tenth of a voxel off zero is
+  kOpen       ///< none of them is (never seen; the zero crossing is returned)
+};
+
+/// What closedSurface simplifies to: at most maxTriangles (0 keeps the raw crossing), within
+/// simplifyError voxels of it.
+struct SurfaceOptions {
+  std::size_t maxTriangles = 3000;
+  double simplifyError = 0.25;
+};
+
+/// The grid's zero crossing as an outward-wound triangle mesh, closed where it can be, then simplified.
+/// Marching cubes can leave a non-manifold edge or vertex where two sheets of the level set touch within a
+/// voxel (a thin wall, a cut grazing a surface); a crossing slightly inside or outside the zero level
+/// separates them, so those are tried next. Empty when the grid holds no surface.
+std::pair<core::TriangleMesh, Meshing> closedSurface(const openvdb::FloatGrid& grid, double voxelSize,
+                                                     const SurfaceOptions& options);
+
+/// Closed, manifold, consistently oriented, and free of the defects validateMesh refuses.
+bool isClosedSolid(const core::TriangleMesh& mesh);
+
+}  // namespace shapedb::volume::detail
