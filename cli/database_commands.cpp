@@ -65,7 +65,7 @@ class ProgressPrinter {
 
 struct BuildCommandOptions {
   std::string path;
-  std::size_t entries = 1800;
+  std::size_t entries = 1100;
   std::string families = "all";
   int modes = 20;
   std::string elements = "quadratic";
@@ -273,9 +273,13 @@ Command addBuildCommand(CLI::App& parent) {
   app->add_option("--entries", o->entries, "Entries in the catalog, spread evenly over the families")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{10'000'000}));
-  app->add_option(
-         "--families", o->families,
-         "Comma-separated families: box, ellipsoid, cylinder, cone, capsule, prism, shard, fragment; or all")
+  std::string names;
+  for (volume::Family f : volume::generatedFamilies())
+    names += (names.empty() ? "" : ", ") + std::string(volume::toString(f));
+  app->add_option("--families", o->families,
+                  "Comma-separated families, or all: " + names +
+                      ". The first eight are convex (the catalog of older databases); the others have the\n"
+                      "handles, hooks, webs, holes, cavities, limbs and lumps of real objects")
       ->capture_default_str();
   app->add_option("--modes", o->modes, "Non-rigid vibration modes per entry")
       ->capture_default_str()

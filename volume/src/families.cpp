@@ -10,6 +10,7 @@
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/families.h>
 
+#include "family_shapes.h"
 #include "polyhedron.h"
 
 namespace shapedb::volume {
@@ -21,11 +22,13 @@ using detail::clip;
 using detail::Polygon;
 using detail::triangulate;
 
-constexpr std::array kGenerated = {Family::kBox,   Family::kEllipsoid, Family::kCylinder,
-                                   Family::kCone,  Family::kCapsule,   Family::kPrism,
-                                   Family::kShard, Family::kFragment};
-constexpr double kMinRatio = 0.1;    ///< thinnest side over the largest
-constexpr double kMaxLength = 10.0;  ///< longest axial length over the cross-section
+constexpr std::array kGenerated = {Family::kBox,     Family::kEllipsoid, Family::kCylinder, Family::kCone,
+                                   Family::kCapsule, Family::kPrism,     Family::kShard,    Family::kFragment,
+                                   Family::kRing,    Family::kRod,       Family::kBeam,     Family::kHoled,
+                                   Family::kShell,   Family::kLimbed,    Family::kStone,    Family::kUnion};
+constexpr std::size_t kConvexCount = 8;  ///< box to fragment
+constexpr double kMinRatio = 0.1;        ///< thinnest side over the largest
+constexpr double kMaxLength = 10.0;      ///< longest axial length over the cross-section
 // Fragments: the broken solid's thinnest side over its largest (a 40 × 30 × 2 cm plate is 0.05), and the
 // number of Voronoi seeds it is broken with.
 constexpr double kMinFragmentSourceRatio = 0.04;
@@ -37,6 +40,26 @@ std::array<double, 2> r2(std::uint32_t i) {
   constexpr double g = 1.32471795724474602596;
   const double n = static_cast<double>(i) + 1.0;
   return {std::fmod(0.5 + n / g, 1.0), std::fmod(0.5 + n / (g * g), 1.0)};
+}
+
+/// t ∈ [0, 1] mapped log-uniformly onto [lo, hi].
+double logLerp(double lo, double hi, double t) {
+  return lo * std::exp(std::log(hi / lo) * t);
+}
+
+double uniformDraw(std::mt19937_64& rng) {
+  return std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+}
+
+/// The salts of the index streams: one for the parameters familySpec draws, another for the shape's own
+/// details, so that neither repeats the other's numbers.
+constexpr std::uint64_t kSpecSalt = 0xF4A6, kShapeSalt = 0x5A17;
+
+/// How far a rod of radius r bent on a radius of 1 can go round before its ends meet: the ends' centres
+/// 1.3 r apart along the chord each side, their inner rims clear.
+double maxRodAngle(double r) {
+  return 2.0 * std::numbers::pi - 2.0 * std::asin(std::min(1.0, 1.3 * r)) -
+         2.0 * std::asin(std::min(1.0, 0.3 * r / (1.0 - r)));
 }
 
 TriangleMesh scaled(TriangleMesh mesh, const Vec3& s) {
@@ -145,6 +168,10 @@ std::span<const Family> generatedFamilies() {
   return kGenerated;
 }
 
+std::span<const Family> convexFamilies() {
+  return std::span<const Family>(kGenerated).first(kConvexCount);
+}
+
 const char* toString(Family family) {
   switch (family) {
     case Family::kBox:
@@ -163,6 +190,22 @@ const char* toString(Family family) {
       return "shard";
     case Family::kFragment:
       return "fragment";
+    case Family::kRing:
+      return "ring";
+    case Family::kRod:
+      return "rod";
+    case Family::kBeam:
+      return "beam";
+    case Family::kHoled:
+      return "holed";
+    case Family::kShell:
+      return "shell";
+    case Family::kLimbed:
+      return "limbed";
+    case Family::kStone:
+      return "stone";
+    case Family::kUnion:
+      return "union";
     case Family::kUser:
       return "user";
   }
@@ -170,8 +213,8 @@ const char* toString(Family family) {
 }
 
 std::optional<Family> parseFamily(std::string_view name) {
-  for (Family f : {Family::kBox, Family::kEllipsoid, Family::kCylinder, Family::kCone, Family::kCapsule,
-                   Family::kPrism, Family::kShard, Family::kFragment, Family::kUser})
+  if (name == toString(Family::kUser)) return Family::kUser;
+  for (Family f : kGenerated)
     if (name == toString(f)) return f;
   return std::nullopt;
 }
@@ -183,10 +226,13 @@ Result<std::vector<Family>> parseFamilies(std::string_view list) {
     const std::size_t comma = list.find(',');
     const std::string_view name = list.substr(0, comma);
     const std::optional<Family> f = parseFamily(name);
-    if (!f || *f == Family::kUser)
+    if (!f || *f == Family::kUser) {
+      std::string known;
+      for (Family g : kGenerated)
+        known += (known.empty() ? "" : ", ") + std::string(toString(g));
       return Error{ErrorCode::kInvalidArgument,
-                   "unknown family '" + std::string(name) +
-                       "' (known: box, ellipsoid, cylinder, cone, capsule, prism, shard, fragment)"};
+                   "unknown family '" + std::string(name) + "' (known: " + known + ")"};
+    }
     if (std::find(families.begin(), families.end(), *f) != families.end())
       return Error{ErrorCode::kInvalidArgument, "family '" + std::string(name) + "' is listed twice"};
     families.push_back(*f);
@@ -226,10 +272,62 @@ ShapeSpec familySpec(Family family, std::uint32_t index) {
       // index's own stream, so that it does not line up with the R2 proportions.
       const double s = std::exp(std::log(kMinFragmentSourceRatio) * u),
                    t = std::exp(std::log(kMinFragmentSourceRatio) * v);
-      std::mt19937_64 rng(index * 0x9E3779B97F4A7C15ull + 0xF4A6);
-      const double w = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      const double w = uniformDraw(rng);
       spec.params = Vec3(std::max(s, t), std::min(s, t),
                          std::floor(kMinPieces * std::exp(std::log(kMaxPieces / kMinPieces) * w)));
+      break;
+    }
+    case Family::kRing:
+      spec.params = Vec3(logLerp(0.12, 0.6, u), logLerp(0.4, 1.0, v), 0.0);
+      break;
+    case Family::kRod: {
+      const double r = logLerp(0.07, 0.3, v);
+      const double angle = 0.5 + (maxRodAngle(r) - 0.5) * u;
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      const bool hook = angle <= std::numbers::pi && uniformDraw(rng) < 0.5;
+      spec.params = Vec3(angle, r, hook ? 0.5 + 2.0 * uniformDraw(rng) : 0.0);
+      break;
+    }
+    case Family::kBeam: {
+      // Heights by section: legs of an L and a U up to as tall as wide; T and H about square; I taller.
+      static constexpr std::array<std::array<double, 2>, 5> kHeights = {
+          {{0.4, 1.0}, {0.5, 1.2}, {0.4, 1.0}, {0.7, 1.1}, {1.3, 2.2}}};
+      const auto section = index % 5;
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      const double h =
+          kHeights[section][0] + (kHeights[section][1] - kHeights[section][0]) * uniformDraw(rng);
+      const double t = std::min(logLerp(0.1, 0.3, u), section == 0 ? 0.6 * h : h / 3.5);
+      spec.params = Vec3(t, logLerp(0.3, 4.0, v), h);
+      break;
+    }
+    case Family::kHoled: {
+      const double a = logLerp(0.3, 1.0, u);
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      spec.params = Vec3(a, std::min(a, logLerp(0.08, 0.5, v)), 1.0 + std::floor(6.0 * uniformDraw(rng)));
+      break;
+    }
+    case Family::kShell: {
+      const double h = logLerp(0.3, 2.0, u);
+      const double w = std::clamp(logLerp(0.1, 0.3, v), 0.06 * std::max(1.0, h), 0.4 * h);
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      spec.params = Vec3(h, w, index % 4 == 3 ? 0.5 + 0.5 * uniformDraw(rng) : 0.0);
+      break;
+    }
+    case Family::kLimbed: {
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      spec.params = Vec3(2.0 + std::floor(5.0 * uniformDraw(rng)), 0.5 + 1.3 * u, logLerp(0.09, 0.22, v));
+      break;
+    }
+    case Family::kStone: {
+      const double a = logLerp(0.45, 1.0, u), b = logLerp(0.3, 1.0, v);
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      spec.params = Vec3(std::max(a, b), std::min(a, b), 0.08 + 0.22 * uniformDraw(rng));
+      break;
+    }
+    case Family::kUnion: {
+      std::mt19937_64 rng = detail::entryStream(index, kSpecSalt);
+      spec.params = Vec3(2.0 + std::floor(3.0 * uniformDraw(rng)), 0.0, 0.0);
       break;
     }
     case Family::kShard:
@@ -254,6 +352,9 @@ std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family>
 Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolution& resolution) {
   const double a = spec.params.x(), b = spec.params.y();
   const int segments = std::max(3, resolution.segments), stacks = std::max(2, resolution.stacks);
+  const auto maxTriangles =
+      static_cast<std::size_t>(std::max(100, segments * resolution.trianglesPerSegment));
+  std::mt19937_64 rng = detail::entryStream(spec.index, kShapeSalt);
   switch (spec.family) {
     case Family::kBox:
       return core::makeBox(Vec3(1.0, a, b));
@@ -272,6 +373,24 @@ Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolutio
       return makeShard(spec.index);
     case Family::kFragment:
       return makeFragment(spec);
+    case Family::kRing:
+      return detail::makeRingShape(a, b, segments);
+    case Family::kRod:
+      return detail::makeRodShape(a, b, spec.params.z(), segments);
+    case Family::kBeam:
+      return detail::makeBeamShape(static_cast<detail::BeamSection>(spec.index % 5), a, spec.params.z(), b);
+    case Family::kStone:
+      return detail::makeStoneShape(a, b, spec.params.z(), rng);
+    case Family::kHoled:
+      return detail::makeHoledShape(a, b, static_cast<int>(spec.params.z()), 0.35 + 0.35 * uniformDraw(rng),
+                                    segments);
+    case Family::kShell:
+      return detail::makeShellShape(static_cast<detail::ShellKind>(spec.index % 4), a, b, spec.params.z(),
+                                    segments);
+    case Family::kLimbed:
+      return detail::makeLimbedShape(static_cast<int>(a), b, spec.params.z(), rng, maxTriangles);
+    case Family::kUnion:
+      return detail::makeUnionShape(static_cast<int>(a), rng, maxTriangles);
     case Family::kUser:
       break;
   }

@@ -13,9 +13,11 @@
 
 namespace shapedb::volume {
 
-/// The shape families of the database (paper §6: six generic families; shards and fragments added for
-/// fracture, the "scenario-based database" of the paper's §7), and
-/// `kUser` for the meshes `shapedb add` brings.
+/// The shape families of the database: the paper's six generic convex families (§6); shards and fragments
+/// for fracture, the "scenario-based database" of its §7; and the non-convex families that real objects
+/// resemble, whose lowest modes live in thin parts (a handle, a limb, a wall, a fin), which no convex
+/// entry has. `kUser` is for the meshes `shapedb add` brings. Stored by name (toString), so the order
+/// here is not part of the file format.
 enum class Family : std::uint8_t {
   kBox,
   kEllipsoid,
@@ -25,12 +27,23 @@ enum class Family : std::uint8_t {
   kPrism,
   kShard,
   kFragment,
+  kRing,
+  kRod,
+  kBeam,
+  kHoled,
+  kShell,
+  kLimbed,
+  kStone,
+  kUnion,
   kUser
 };
 
 /// The families a default build uses, in catalog order: all but kUser.
 std::span<const Family> generatedFamilies();
-/// "box", "ellipsoid", "cylinder", "cone", "capsule", "prism", "shard", "fragment", "user".
+/// The convex families of databases built before the non-convex ones existed: box to fragment.
+std::span<const Family> convexFamilies();
+/// "box", "ellipsoid", "cylinder", "cone", "capsule", "prism", "shard", "fragment", "ring", "rod", "beam",
+/// "holed", "shell", "limbed", "stone", "union", "user".
 const char* toString(Family family);
 std::optional<Family> parseFamily(std::string_view name);
 /// A comma-separated list of family names ("box,cone"); "all" for generatedFamilies().
@@ -50,10 +63,33 @@ Result<std::vector<Family>> parseFamilies(std::string_view list);
 /// - fragment: what fracture breaks off a solid: the Voronoi cell of one of p random seeds inside a box,
 ///   an ellipsoid or an elliptic cylinder (by index mod 3) of semi-axes 1 ≥ a ≥ b ≥ 0.04, clipped to it;
 ///   a and b log-uniform as for boxes, p log-uniform in [4, 100), the seeds from the index.
+/// The non-convex families sweep what sets their lowest modes (sizes are relative: normalization takes the
+/// scale away), log-uniform unless said. Their thinnest parts stop at about a tenth of their length: an
+/// entry's tets, and so its build time, grow as the inverse square of its thinness.
+/// - ring (handles, rings, washers): a torus of centre-line radius 1, section radius r ∈ [0.12, 0.6],
+///   section flattened along the axis to f ∈ [0.4, 1] of that; params (r, f, 0);
+/// - rod (bent rods, arcs, hooks): a round rod of radius r ∈ [0.07, 0.3] bent through θ (uniform, 0.5 rad
+///   to as far as its ends stay clear) on a radius of 1; arcs up to π get a straight shank s ∈ [0.5, 2.5]
+///   (a hook) half the time; params (θ, r, s);
+/// - beam (brackets and beams): L, T, U, H and I sections by index mod 5, flange width 1, walls
+///   t ∈ [0.1, 0.3], length c ∈ [0.3, 4], height h from the index's stream; params (t, c, h);
+/// - holed (plates and blocks with holes): a 2 × 2a × 2b box, a ∈ [0.3, 1], b ∈ [0.08, 0.5] (at most a),
+///   pierced through b by n ∈ [1, 6] round holes on a grid, each 0.35 to 0.7 of its cell across;
+///   params (a, b, n);
+/// - shell (cups, bowls, tubes, boxes open on one side, by index mod 4): radius 1, half-height
+///   h ∈ [0.3, 2], walls w ∈ [0.1, 0.3] (and at least 0.06·max(1, h) and at most 0.4 h), an open
+///   box d ∈ [0.5, 1] (uniform) deep; params (h, w, d or 0);
+/// - limbed (animals, figures): an ellipsoidal body of half-length 1 with n ∈ [2, 6] limbs of length
+///   l ∈ [0.5, 1.8] (uniform) and radius r ∈ [0.09, 0.22], maybe a head and ears; params (n, l, r);
+/// - stone (lumpy stones): an ellipsoid (1, a, b), 1 ≥ a ≥ b ≥ 0.3, a ≥ 0.45, its radius modulated by
+///   smooth random waves of total amplitude m ∈ [0.08, 0.3] (uniform); params (a, b, m);
+/// - union (unions of primitives): n ∈ [2, 4] boxes, ellipsoids, cylinders and capsules of random
+///   proportions, orientations and overlaps; params (n, 0, 0).
+/// The drawn details (hole positions, limb placement, waves, primitives) come from the index's stream.
 struct ShapeSpec {
   Family family = Family::kBox;
   std::uint32_t index = 0;                 ///< position in the family's sweep
-  core::Vec3 params = core::Vec3::Zero();  ///< (a, c or b, 0); fragments (a, b, p); shards: zero
+  core::Vec3 params = core::Vec3::Zero();  ///< (a, c or b, 0); fragments (a, b, p); shards: zero; above
   /// "box-00017": unique within a database, stable across builds of any size.
   std::string name() const;
 };
@@ -67,11 +103,15 @@ std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family>
 
 /// Surface resolution of curved families.
 struct ShapeResolution {
-  int segments = 24;  ///< around the axis (cylinder, cone, capsule, ellipsoid)
+  int segments = 24;  ///< around the axis (cylinder, cone, capsule, ellipsoid; a ring's or rod's section)
   int stacks = 12;    ///< pole to pole (ellipsoid); capsule caps get half each
+  /// Triangles of the families made from level sets (limbed, union) per segment.
+  int trianglesPerSegment = 20;
 };
 
-/// The closed, outward-oriented surface mesh of a spec. Errors: kInvalidArgument for kUser.
+/// The closed, outward-oriented surface mesh of a spec: one connected solid, which TetGen meshes.
+/// Deterministic. The families made from level sets (limbed, union) take milliseconds to
+/// tens of milliseconds; the others microseconds. Errors: kInvalidArgument for kUser.
 Result<core::TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolution& resolution = {});
 
 }  // namespace shapedb::volume
