@@ -14,6 +14,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <shapedb/core/mass_properties.h>
+#include <shapedb/core/normalize.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/database.h>
 #include <shapedb/io/store.h>
@@ -37,6 +39,10 @@ BuildOptions smallBuild(std::size_t entries, std::vector<volume::Family> familie
   options.batchSize = 4;
   return options;
 }
+
+/// Entries of each family in the suite's database (sixteen families; the non-convex ones cost seconds an
+/// entry under the sanitizers).
+constexpr std::size_t kPerFamily = 2;
 
 /// The suite's database, built once per test binary and shared by the suite's ctest processes (each
 /// test runs in a process of its own, and the build is most of their time under the sanitizers): beside
@@ -64,19 +70,30 @@ Result<std::filesystem::path> suiteDatabase() {
     if (old.path().filename() != "lock") std::filesystem::remove(old.path(), ec);
   const std::filesystem::path building = dir / (name + ".building");
   const auto families = volume::generatedFamilies();
-  auto report = buildDatabase(building, smallBuild(3 * families.size(), {families.begin(), families.end()}));
+  auto report =
+      buildDatabase(building, smallBuild(kPerFamily * families.size(), {families.begin(), families.end()}));
   if (!report) return report.error();
-  if (report->built != 3 * families.size() || report->failed != 0)
+  if (report->built != kPerFamily * families.size() || report->failed != 0)
     return Error{ErrorCode::kInvalidArgument, std::to_string(report->built) + " entries built, " +
                                                   std::to_string(report->failed) + " failed; expected " +
-                                                  std::to_string(3 * families.size()) + " and 0"};
+                                                  std::to_string(kPerFamily * families.size()) + " and 0"};
   std::filesystem::rename(building, path, ec);
   if (ec) return Error{ErrorCode::kIo, path.string() + ": " + ec.message()};
   return path;
 }
 
-/// One database for the suite: 3 entries of each generated family. A build that fails fails every test
-/// (an assertion in SetUpTestSuite would make GoogleTest skip them, and ctest report them as skipped).
+/// Whether a shape has a continuous symmetry that its normalization leaves open (two equal principal
+/// moments and no angular harmonic of order 2 to 6 about the third axis: a ring, a cup, a tube). A query
+/// finds it by the turns about that axis that it samples, so the match's frame is the query's only to
+/// within half a turn step, and its descriptor distance, surface deviation and placed tets are close,
+/// not exact.
+bool turnsSampled(const core::TriangleMesh& surface) {
+  const auto frame = core::normalize(surface, *core::computeMassProperties(surface));
+  return frame->isDegenerate() && frame->planeSymmetry == 0;
+}
+
+/// One database for the suite: kPerFamily entries of each generated family. A build that fails fails every
+/// test (an assertion in SetUpTestSuite would make GoogleTest skip them, and ctest report them as skipped).
 class SmallDatabase : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -103,7 +120,7 @@ std::filesystem::path SmallDatabase::sPath;
 TEST_F(SmallDatabase, EveryEntryQueriedWithItsOwnSurfaceUnderARigidTransformIsTopOne) {
   auto db = Database::open(sPath);
   ASSERT_TRUE(db.ok()) << db.error().message;
-  ASSERT_EQ(db->entries().size(), 3 * volume::generatedFamilies().size());
+  ASSERT_EQ(db->entries().size(), kPerFamily * volume::generatedFamilies().size());
   std::mt19937_64 rng(2024);
   for (const EntryRecord& e : db->entries()) {
     const volume::ShapeSpec spec = volume::familySpec(
@@ -118,7 +135,8 @@ TEST_F(SmallDatabase, EveryEntryQueriedWithItsOwnSurfaceUnderARigidTransformIsTo
           core::transformed(*surface, test::randomSimilarity(rng, 5.0, 1.0, 1.0));
       auto matches = db->match(moved, kind, {.k = 3});
       ASSERT_TRUE(matches.ok()) << matches.error().message;
-      EXPECT_LT(matches->front().distance, 1e-6) << e.name << " " << core::toString(kind);
+      EXPECT_LT(matches->front().distance, turnsSampled(*surface) ? 1e-2 : 1e-6)
+          << e.name << " " << core::toString(kind);
       if (kind == DescriptorKind::kVoxel && matches->front().entry != e.id) {
         // Binary occupancy cannot tell a short capsule from the cylinder of the same proportions on a 10³
         // grid: they fill the same cells. Then the entry must tie for first, at distance 0.
@@ -143,7 +161,8 @@ TEST_F(SmallDatabase, PhysicsReadBackMatchesAFreshComputation) {
   const EntryRecord& e = db->entries()[4];
   auto physics = db->physics(e.id);
   ASSERT_TRUE(physics.ok()) << physics.error().message;
-  auto surface = volume::makeFamilyShape(volume::familySpec(e.family, 1), db->parameters().resolution);
+  const auto index = static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1)));
+  auto surface = volume::makeFamilyShape(volume::familySpec(e.family, index), db->parameters().resolution);
   ASSERT_TRUE(surface.ok());
   auto fresh = volume::computeEntry(*surface, db->parameters().entry);
   ASSERT_TRUE(fresh.ok());
@@ -182,7 +201,7 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
   ASSERT_TRUE(db.ok()) << db.error().message;
   std::mt19937_64 rng(77);
   const core::Material glass = *core::materialPreset("glass");
-  for (std::size_t i = 0; i < db->entries().size(); i += 3) {  // one entry of each family
+  for (std::size_t i = 0; i < db->entries().size(); i += kPerFamily) {  // one entry of each family
     const EntryRecord& e = db->entries()[i];
     const volume::ShapeSpec spec = volume::familySpec(
         e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
@@ -199,9 +218,11 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     EXPECT_EQ(r->matches[0].match.entry, e.id) << e.name;
     ASSERT_TRUE(r->matches[0].fidelity && r->matches[1].fidelity);
     const core::Fidelity& f = *r->matches[0].fidelity;
-    EXPECT_LT(f.descriptorDistance, 1e-6) << e.name;
+    const bool sampled = turnsSampled(*surface);
+    EXPECT_LT(f.descriptorDistance, sampled ? 1e-2 : 1e-6) << e.name;
     EXPECT_LT(f.maxMomentError, 1e-6) << e.name;
-    EXPECT_LT(f.maxDeviation, 1e-6) << e.name << ": the placed tets' boundary is the query's surface";
+    EXPECT_LT(f.maxDeviation, sampled ? 1e-2 : 1e-6)
+        << e.name << ": the placed tets' boundary is the query's surface";
     EXPECT_GT(r->matches[1].fidelity->meanDeviation, f.meanDeviation) << e.name;
 
     // Scaling laws against the query's own size L and the material.
@@ -216,6 +237,8 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     EXPECT_EQ(p.stretch, core::Vec3::Ones());  // the paper's uniform scaling, by default
     for (Eigen::Index m = 0; m < expected.size(); ++m)
       EXPECT_NEAR(p.frequenciesHz()[m] / expected[m], 1.0, 1e-12);
+    if (sampled) continue;  // the checks below need the query's own frame
+
     // The entry has the query's shape already: the geometry correction moves nothing (its boundary is the
     // query's surface), and the modes computed again on the unmoved tets are the entry's, for glass's own
     // Poisson ratio (0.22; the database's is 0.3): no warning about it.
@@ -269,12 +292,12 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
   }
 }
 
-// A query that no entry's tets can be morphed onto (a needle, 60 : 1 : 1, far beyond every entry's
+// A query that no entry's tets can be morphed onto (a needle, 120 : 1 : 1, far beyond every entry's
 // proportions): the correction is refused, and the answer is the uncorrected one, with the reason.
 TEST_F(SmallDatabase, ACorrectionThatWouldInvertATetKeepsTheEntrysDataAndSaysWhy) {
   auto db = Database::open(sPath);
   ASSERT_TRUE(db.ok()) << db.error().message;
-  const core::TriangleMesh needle = core::makeBox({0.6, 0.01, 0.01});
+  const core::TriangleMesh needle = core::makeBox({0.6, 0.005, 0.005});
   QueryOptions options;
   options.fidelity = false;
   auto plain = db->query(needle, options);
@@ -282,7 +305,7 @@ TEST_F(SmallDatabase, ACorrectionThatWouldInvertATetKeepsTheEntrysDataAndSaysWhy
   options.correct = true;
   auto r = db->query(needle, options);
   ASSERT_TRUE(r.ok() && r->physics) << (r ? "" : r.error().message);
-  EXPECT_FALSE(r->correction.has_value());
+  EXPECT_FALSE(r->correction.has_value()) << db->entry(plain->matches[0].match.entry)->name;
   ASSERT_FALSE(r->physics->warnings.empty());
   EXPECT_NE(r->physics->warnings.back().find("geometry correction not applied"), std::string::npos)
       << r->physics->warnings.back();
