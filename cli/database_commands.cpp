@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unistd.h>
 
@@ -152,7 +153,31 @@ int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
 struct InfoOptions {
   std::string path;
   bool json = false;
+  bool check = false;
 };
+
+/// `info --check`: the report as JSON.
+nlohmann::json checkJson(const io::IntegrityReport& report) {
+  nlohmann::json damaged = nlohmann::json::array();
+  for (const io::IntegrityReport::Damage& d : report.damaged)
+    damaged.push_back({{"entry_id", d.entry}, {"name", d.name}, {"part", d.part}});
+  return {{"ok", report.ok()},
+          {"blobs_checked", report.blobsChecked},
+          {"sqlite_problems", report.sqliteProblems},
+          {"damaged", damaged}};
+}
+
+/// `info --check`: the report as text, one line per problem.
+void printCheck(const io::IntegrityReport& report) {
+  std::printf("check: SQLite's integrity check %s; %zu blobs read, %zu damaged\n",
+              report.sqliteProblems.empty() ? "passed" : "found problems", report.blobsChecked,
+              report.damaged.size());
+  for (const std::string& line : report.sqliteProblems)
+    std::printf("  sqlite: %s\n", line.c_str());
+  for (const io::IntegrityReport::Damage& d : report.damaged)
+    std::printf("  damaged: %s (entry %u): %s does not match its checksum\n", d.name.c_str(), d.entry,
+                d.part.c_str());
+}
 
 int runInfo(const InfoOptions& o) {
   auto store = io::Store::open(o.path);
@@ -166,6 +191,17 @@ int runInfo(const InfoOptions& o) {
     printError((entries ? failures.error() : entries.error()).message);
     return kExitInputError;
   }
+  std::optional<io::IntegrityReport> check;
+  if (o.check) {
+    auto report = store->check();
+    if (!report) {
+      printError(report.error().message);
+      return kExitInputError;
+    }
+    check = std::move(report).value();
+  }
+  // A damaged file is reported in full, then fails the command.
+  const int exitCode = !check || check->ok() ? kExitOk : kExitInputError;
   std::map<std::string, std::size_t> perFamily;
   std::size_t nodes = 0, tets = 0;
   for (const io::EntryRecord& r : *entries) {
@@ -188,22 +224,22 @@ int runInfo(const InfoOptions& o) {
   for (const io::FailureRecord& f : *failures)
     failed.push_back({{"name", f.name}, {"message", f.message}});
   if (o.json) {
-    const nlohmann::json out = {
-        {"file", o.path},
-        {"schema_version", io::kSchemaVersion},
-        {"status", status},
-        {"created", store->meta("created").value_or("")},
-        {"entries", n},
-        {"families", families},
-        {"failures", failed},
-        {"parameters", nlohmann::json::parse(io::toJson(store->parameters()))},
-        {"size_bytes", bytes},
-        {"bytes_per_entry", n ? static_cast<double>(bytes) / static_cast<double>(n) : 0.0},
-        {"build_seconds", buildSeconds},
-        {"mean_nodes", n ? static_cast<double>(nodes) / static_cast<double>(n) : 0.0},
-        {"mean_tets", n ? static_cast<double>(tets) / static_cast<double>(n) : 0.0}};
+    nlohmann::json out = {{"file", o.path},
+                          {"schema_version", io::kSchemaVersion},
+                          {"status", status},
+                          {"created", store->meta("created").value_or("")},
+                          {"entries", n},
+                          {"families", families},
+                          {"failures", failed},
+                          {"parameters", nlohmann::json::parse(io::toJson(store->parameters()))},
+                          {"size_bytes", bytes},
+                          {"bytes_per_entry", n ? static_cast<double>(bytes) / static_cast<double>(n) : 0.0},
+                          {"build_seconds", buildSeconds},
+                          {"mean_nodes", n ? static_cast<double>(nodes) / static_cast<double>(n) : 0.0},
+                          {"mean_tets", n ? static_cast<double>(tets) / static_cast<double>(n) : 0.0}};
+    if (check) out["check"] = checkJson(*check);
     std::printf("%s\n", out.dump(2).c_str());
-    return kExitOk;
+    return exitCode;
   }
   const io::BuildParameters& p = store->parameters();
   std::printf("%s: shapedb database, schema %d, %s, created %s\n", o.path.c_str(), io::kSchemaVersion,
@@ -229,7 +265,8 @@ int runInfo(const InfoOptions& o) {
       p.entry.tetgen.maxRadiusEdgeRatio,
       p.entry.tetgen.maxVolumeFraction > 0 ? 1.0 / p.entry.tetgen.maxVolumeFraction : 0.0,
       p.entry.collision.maxShapes, p.entry.damping.alpha, p.entry.damping.beta);
-  return kExitOk;
+  if (check) printCheck(*check);
+  return exitCode;
 }
 
 struct AddOptions {
@@ -273,13 +310,18 @@ Command addBuildCommand(CLI::App& parent) {
   app->add_option("--entries", o->entries, "Entries in the catalog, spread evenly over the families")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{10'000'000}));
-  std::string names;
-  for (volume::Family f : volume::generatedFamilies())
-    names += (names.empty() ? "" : ", ") + std::string(volume::toString(f));
-  app->add_option("--families", o->families,
-                  "Comma-separated families, or all: " + names +
-                      ". The first eight are convex (the catalog of older databases); the others have the\n"
-                      "handles, hooks, webs, holes, cavities, limbs and lumps of real objects")
+  const auto join = [](auto families) {
+    std::string names;
+    for (volume::Family f : families)
+      names += (names.empty() ? "" : ", ") + std::string(volume::toString(f));
+    return names;
+  };
+  const auto all = volume::generatedFamilies(), convex = volume::convexFamilies();
+  app->add_option(
+         "--families", o->families,
+         "Comma-separated families, or all. Convex (the catalog of older databases):\n" + join(convex) +
+             ".\nWith the handles, hooks, webs, holes, cavities, limbs and lumps of real objects:\n" +
+             join(all.subspan(convex.size())))
       ->capture_default_str();
   app->add_option("--modes", o->modes, "Non-rigid vibration modes per entry")
       ->capture_default_str()
@@ -315,9 +357,13 @@ Command addInfoCommand(CLI::App& parent) {
   auto o = std::make_shared<InfoOptions>();
   CLI::App* app = parent.add_subcommand(
       "info",
-      "Describe a database file: entries per family, failures, build parameters, size on disk, build time.");
+      "Describe a database file: entries per family, failures, build parameters, size on disk, build time.\n"
+      "A file that holds a trigger, view, table or index shapedb does not create is refused (untrusted).");
   app->add_option("DB", o->path, "Database file")->required();
   app->add_flag("--json", o->json, "Print one JSON object instead of text");
+  app->add_flag("--check", o->check,
+                "Also check the whole file: SQLite's integrity check, and every blob against its checksum\n"
+                "(a damaged entry is named; exit status 1 if anything is damaged)");
   return {app, [o] { return runInfo(*o); }};
 }
 

@@ -310,5 +310,100 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
   EXPECT_NE(resumed.err.find("another elements"), std::string::npos) << resumed.err;
 }
 
+/// Runs one SQL statement on a database file with SQLite itself, as someone who edited the file would.
+void execSql(const std::filesystem::path& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  char* message = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &message), SQLITE_OK) << (message ? message : "");
+  sqlite3_free(message);
+  sqlite3_close(db);
+}
+
+// A database from elsewhere is untrusted: one with a trigger, a view or a table that shapedb does not
+// create is refused by every command that opens it, by name, and nothing in it changes.
+TEST(UntrustedDatabase, ATriggerViewOrExtraTableIsRefusedAndTheFileLeftUnchanged) {
+  test::ScratchDir dir("untrusted");
+  const auto clean = dir / "clean.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", clean.string(), "--entries", "2", "--families", "box",
+                                           "--modes", "2", "--quiet"})
+                .exitCode,
+            0);
+  const auto mesh = dir / "box.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeBox({0.3, 0.2, 0.1}), mesh).ok());
+  const std::vector<std::pair<std::string, std::string>> additions = {
+      {"trigger 'grow'", "CREATE TRIGGER grow AFTER INSERT ON entries BEGIN DELETE FROM meta; END"},
+      {"view 'everything'", "CREATE VIEW everything AS SELECT * FROM entries"},
+      {"table 'notes'", "CREATE TABLE notes(text TEXT)"},
+      {"index 'by_family'", "CREATE INDEX by_family ON entries(family)"}};
+  for (const auto& [object, sql] : additions) {
+    SCOPED_TRACE(object);
+    const auto db = dir / "edited.db";
+    std::filesystem::copy_file(clean, db, std::filesystem::copy_options::overwrite_existing);
+    execSql(db, sql);
+    const std::string before = test::readFile(db);
+    for (const std::vector<std::string>& command :
+         {std::vector<std::string>{"info", db.string()},
+          std::vector<std::string>{"query", db.string(), mesh.string()},
+          std::vector<std::string>{"add", db.string(), mesh.string()}}) {
+      const test::ProcessResult r = test::runProcess(SHAPEDB_CLI, command);
+      EXPECT_EQ(r.exitCode, 1) << command[0] << ": " << r.err;
+      EXPECT_NE(r.err.find(db.string() + ": holds " + object + ", which shapedb does not create"),
+                std::string::npos)
+          << command[0] << ": " << r.err;
+    }
+    EXPECT_TRUE(test::readFile(db) == before) << "a refused file changed";
+  }
+  // The clean file itself is read as ever.
+  EXPECT_EQ(test::runProcess(SHAPEDB_CLI, {"info", clean.string()}).exitCode, 0);
+}
+
+// info --check: SQLite's integrity check and every blob's checksum; a byte flipped inside one entry's
+// modes is found, and the entry named.
+TEST(InfoCli, CheckFindsAByteFlippedInsideABlobAndNamesTheEntry) {
+  test::ScratchDir dir("check");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "3", "--families", "box",
+                                           "--modes", "2", "--quiet"})
+                .exitCode,
+            0);
+  const test::ProcessResult good = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--check", "--json"});
+  ASSERT_EQ(good.exitCode, 0) << good.err;
+  const nlohmann::json report = nlohmann::json::parse(good.out)["check"];
+  EXPECT_TRUE(report["ok"].get<bool>());
+  EXPECT_EQ(report["blobs_checked"].get<int>(), 3 * (3 + 5));  // three descriptors, five physics parts
+  EXPECT_TRUE(report["damaged"].empty());
+
+  // The middle byte of box-00001's modes, its bits flipped in place (SQLite's incremental blob I/O: the
+  // blob keeps its size and its stored checksum).
+  {
+    sqlite3* handle = nullptr;
+    ASSERT_EQ(sqlite3_open_v2(db.c_str(), &handle, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+    sqlite3_stmt* row = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(handle,
+                                 "SELECT p.rowid FROM physics p JOIN entries e ON e.id = p.entry_id "
+                                 "WHERE e.name = 'box-00001' AND p.part = 2",
+                                 -1, &row, nullptr),
+              SQLITE_OK);
+    ASSERT_EQ(sqlite3_step(row), SQLITE_ROW);
+    const sqlite3_int64 rowid = sqlite3_column_int64(row, 0);
+    sqlite3_finalize(row);
+    sqlite3_blob* blob = nullptr;
+    ASSERT_EQ(sqlite3_blob_open(handle, "main", "physics", "data", rowid, 1, &blob), SQLITE_OK);
+    const int middle = sqlite3_blob_bytes(blob) / 2;
+    unsigned char byte = 0;
+    ASSERT_EQ(sqlite3_blob_read(blob, &byte, 1, middle), SQLITE_OK);
+    byte = static_cast<unsigned char>(~byte);
+    ASSERT_EQ(sqlite3_blob_write(blob, &byte, 1, middle), SQLITE_OK);
+    sqlite3_blob_close(blob);
+    sqlite3_close(handle);
+  }
+  const test::ProcessResult bad = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--check"});
+  EXPECT_EQ(bad.exitCode, 1) << bad.out << bad.err;
+  EXPECT_NE(bad.out.find("1 damaged"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("damaged: box-00001"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("modes does not match its checksum"), std::string::npos) << bad.out;
+}
+
 }  // namespace
 }  // namespace shapedb::cli

@@ -62,10 +62,29 @@ struct FailureRecord {
   std::string message;
 };
 
+/// What Store::check found: SQLite's own integrity check, and every blob against its checksum.
+struct IntegrityReport {
+  /// A blob whose bytes no longer match their checksum.
+  struct Damage {
+    core::EntryId entry = 0;
+    std::string name;  ///< the entry's name ("entry N" for a blob of no entry)
+    std::string part;  ///< "tet mesh", "modes", ..., or "centroid-voxel descriptor"
+  };
+  std::vector<std::string> sqliteProblems;  ///< PRAGMA integrity_check's lines, if it found anything
+  std::vector<Damage> damaged;
+  std::size_t blobsChecked = 0;
+  bool ok() const { return sqliteProblems.empty() && damaged.empty(); }
+};
+
 /// The database file (SQLite, WAL mode): schema version and application id in the header, the build
 /// parameters and bookkeeping in `meta`, then `entries`, `descriptors` (one blob per entry and kind),
 /// `physics` (one blob per entry and part: tet mesh, mass properties, modes, collision, sound) and
 /// `failures`. Every blob has a CRC-32 beside it, checked on read.
+///
+/// A file is untrusted input (databases are passed around): it is opened with SQLite's defences for
+/// such files (defensive mode, no trusted schema, bounded lengths, nothing attached), and a file whose
+/// schema holds an object shapedb does not create (a trigger, a view, a table or index of its own) is
+/// refused before anything reads it.
 ///
 /// Thread-safe: one connection in SQLite's serialized mode; writes are one transaction per call.
 class Store {
@@ -73,7 +92,8 @@ class Store {
   /// A new file. Errors: kIo if it exists or cannot be created.
   static Result<Store> create(const std::filesystem::path& path, const BuildParameters& parameters);
   /// An existing file. Errors: kIo (missing, unreadable; `writable` and the file is read-only), kParse
-  /// (not SQLite, another application's file, another schema version, unreadable parameters).
+  /// (not SQLite, another application's file, another schema version, unreadable parameters, a schema
+  /// object shapedb does not create, named).
   static Result<Store> open(const std::filesystem::path& path, bool writable = false);
 
   Store(Store&&) noexcept;
@@ -96,6 +116,10 @@ class Store {
   /// One entry's physical data, checksums verified. Errors: kInvalidArgument (no such entry), kParse
   /// (a corrupted blob: the message names the entry and the part).
   Result<core::PhysicalData> physics(core::EntryId id) const;
+
+  /// SQLite's integrity check, then every blob read and checked against its checksum (the whole file:
+  /// seconds for the default database). Errors: kIo only where SQLite cannot read at all.
+  Result<IntegrityReport> check() const;
 
   /// Checkpoints the write-ahead log into the file and leaves it in rollback-journal mode: one
   /// self-contained file, readable from a read-only folder or medium. The next write switches back
