@@ -323,9 +323,6 @@ bool Database::supportsStretchCorrection() const {
 const std::vector<EntryRecord>& Database::entries() const {
   return mImpl->entries;
 }
-const Store& Database::store() const {
-  return mImpl->store;
-}
 const EntryRecord* Database::entry(core::EntryId id) const {
   const auto it = mImpl->byId.find(id);
   return it == mImpl->byId.end() ? nullptr : &mImpl->entries[it->second];

@@ -104,9 +104,6 @@ class Index {
   /// Bytes held by the index's arrays.
   std::size_t memoryBytes() const;
 
-  /// Filled-cell count of the entry at position `slot` (entries sorted by count); for tests.
-  std::uint32_t slotCount(std::size_t slot) const { return mCounts[slot]; }
-
  private:
   friend class IndexBuilder;
   struct Query;

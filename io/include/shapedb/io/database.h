@@ -158,7 +158,6 @@ class Database {
   const std::vector<EntryRecord>& entries() const;
   const EntryRecord* entry(core::EntryId id) const;
   const core::Index& index(core::DescriptorKind kind) const;
-  const Store& store() const;
 
   /// The k most similar entries to `mesh` (any frame, any size) by the descriptor `kind`: exact mass
   /// properties → normalize → describe every orientation candidate → exact search.
