@@ -90,9 +90,13 @@ void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queri
     options.method = SearchMethod::kPruned;
     expectSameMatches(searchOrDie(index, candidates, options, &pruned), expected,
                       "query " + std::to_string(q));
-    options.parallel = false;
-    expectSameMatches(searchOrDie(index, candidates, options), expected,
-                      "query " + std::to_string(q) + ", one thread");
+    // One thread gives what many do: on every tenth query (the pruned scan alone is most of this
+    // test's time at scale).
+    if (q % 10 == 0) {
+      options.parallel = false;
+      expectSameMatches(searchOrDie(index, candidates, options), expected,
+                        "query " + std::to_string(q) + ", one thread");
+    }
     if (::testing::Test::HasFailure()) break;
   }
   std::cout << "  " << toString(kind) << ": pruned search computed " << pruned.distanceEvaluations

@@ -40,9 +40,9 @@ BuildOptions smallBuild(std::size_t entries, std::vector<volume::Family> familie
   return options;
 }
 
-/// Entries of each family in the suite's database (sixteen families; the non-convex ones cost seconds an
-/// entry under the sanitizers).
-constexpr std::size_t kPerFamily = 2;
+/// Entries of each family in the suite's database: one (sixteen families; the non-convex ones cost
+/// seconds an entry under the sanitizers, and the database is most of this suite's time there).
+constexpr std::size_t kPerFamily = 1;
 
 /// The suite's database, built once per test binary and shared by the suite's ctest processes (each
 /// test runs in a process of its own, and the build is most of their time under the sanitizers): beside

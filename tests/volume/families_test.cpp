@@ -30,7 +30,7 @@ std::vector<Family> nonConvexFamilies() {
 
 TEST(Families, EveryShapeOfEveryFamilyIsOneValidClosedSolidAndDeterministic) {
   for (Family family : generatedFamilies()) {
-    const std::uint32_t count = fromLevelSets(family) ? 4 : 24;
+    const std::uint32_t count = fromLevelSets(family) ? 4 : 16;
     for (std::uint32_t i = 0; i < count; ++i) {
       const ShapeSpec spec = familySpec(family, i);
       auto mesh = makeFamilyShape(spec);
@@ -83,7 +83,8 @@ TEST(Families, TheNonConvexFamiliesHaveTheirHolesAndHollows) {
 }
 
 // TetGen meshes every non-convex family as the build will (quadratic entries' bounds), and the tets
-// fill the surface.
+// fill the surface. (Release builds only, as the next: the sanitizer preset covers TetGen and describe
+// elsewhere, and the families' own code above.)
 TEST(Families, TetGenMeshesASampleOfEveryNonConvexFamily) {
   const TetrahedralizeOptions options = entryMeshing(ElementOrder::kQuadratic);
   const ShapeResolution resolution{.segments = 16, .stacks = 8};
