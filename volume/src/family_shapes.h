@@ -1,9 +1,9 @@
 #pragma once
 
-// The generators of the families that real objects resemble: handles, rods, beams, stones (meshed
-// directly, swept_shapes.cpp) and plates with holes, shells, limbed bodies, unions of primitives (built
-// by constructive solid geometry on level sets, csg_shapes.cpp). Internal to volume: families.cpp owns
-// the parameters (ShapeSpec) and calls these.
+// The generators of the families that real objects resemble: rings, rods, beams, plates with holes,
+// shells and stones (meshed directly, swept_shapes.cpp), limbed bodies and unions of primitives (built by
+// constructive solid geometry on level sets: composite_shapes.cpp draws the terms, csg.cpp meshes them).
+// Internal to volume: families.cpp owns the parameters (ShapeSpec) and calls these.
 
 #include <cstdint>
 #include <random>
@@ -72,10 +72,11 @@ struct CsgTerm {
   bool subtract = false;
 };
 
-/// The solid of `terms` in order (the first is added), meshed from level sets whose voxel resolves
-/// `thinnest` (m, the thinnest wall or ligament) with at least five voxels (and the whole at most 240
-/// voxels across), simplified to at most `maxTriangles`. Errors: kNotClosed when the result is not one
-/// closed, manifold solid (the caller draws again), kInvalidArgument for no terms.
+/// The solid of `terms` in order (the first is added), meshed from level sets whose voxel puts three across
+/// `thinnest` (m, the thinnest wall or ligament) unless the surface would then be more than ~20,000 raw
+/// triangles (48 to 240 voxels across the whole), then simplified toward `maxTriangles` within a voxel.
+/// Errors: kNotClosed when the result is not one closed, manifold solid (the caller draws again),
+/// kInvalidArgument for no terms.
 Result<core::TriangleMesh> meshCsg(std::span<const CsgTerm> terms, double thinnest, std::size_t maxTriangles);
 
 }  // namespace shapedb::volume::detail

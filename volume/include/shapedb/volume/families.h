@@ -111,7 +111,8 @@ struct ShapeResolution {
 
 /// The closed, outward-oriented surface mesh of a spec: one connected solid, which TetGen meshes.
 /// Deterministic. The families made from level sets (limbed, union) take milliseconds to
-/// tens of milliseconds; the others microseconds. Errors: kInvalidArgument for kUser.
+/// tenths of a second; the others microseconds. Errors: kInvalidArgument for kUser; kNotClosed if a
+/// level-set family's sixteen draws for an index all fail to come out as one closed piece (never seen).
 Result<core::TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolution& resolution = {});
 
 }  // namespace shapedb::volume
