@@ -9,6 +9,8 @@
 #include <shapedb/volume/collision.h>
 #include <shapedb/volume/openvdb_runtime.h>
 
+#include "level_set.h"
+
 namespace shapedb::volume {
 namespace {
 
@@ -52,18 +54,11 @@ Samples sampleSolid(const core::TriangleMesh& surface, int resolution) {
   // OpenVDB's voxel centres at index (i, j, k) are origin + voxel·(i, j, k): a transform with that origin.
   auto transform = openvdb::math::Transform::createLinearTransform(s.voxel);
   transform->postTranslate(openvdb::Vec3d(s.origin.x(), s.origin.y(), s.origin.z()));
-  std::vector<openvdb::Vec3s> points;
-  points.reserve(surface.vertices.size());
-  for (const Vec3& p : surface.vertices)
-    points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-  std::vector<openvdb::Vec3I> triangles;
-  triangles.reserve(surface.triangles.size());
-  for (const auto& t : surface.triangles)
-    triangles.emplace_back(t[0], t[1], t[2]);
+  const detail::OpenVdbMesh vdb = detail::toOpenVdb(surface);
   // The interior band covers the whole solid: distances everywhere inside, for the inscribed spheres.
   const float interior = static_cast<float>(bounds.extent().maxCoeff() / s.voxel);
   const auto grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(
-      *transform, points, triangles, std::vector<openvdb::Vec4I>{}, 3.0f, interior);
+      *transform, vdb.points, vdb.triangles, std::vector<openvdb::Vec4I>{}, 3.0f, interior);
   const auto accessor = grid->getConstAccessor();
   s.distance.resize(static_cast<std::size_t>(s.n[0]) * s.n[1] * s.n[2]);
   for (int k = 0; k < s.n[2]; ++k)

@@ -38,16 +38,21 @@ TriangleMesh crossing(const openvdb::FloatGrid& grid, double isovalue) {
 
 }  // namespace
 
-openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::Transform& transform) {
-  std::vector<openvdb::Vec3s> points;
-  points.reserve(mesh.vertices.size());
+OpenVdbMesh toOpenVdb(const TriangleMesh& mesh) {
+  OpenVdbMesh out;
+  out.points.reserve(mesh.vertices.size());
   for (const Vec3& p : mesh.vertices)
-    points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-  std::vector<openvdb::Vec3I> triangles;
-  triangles.reserve(mesh.triangles.size());
+    out.points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+  out.triangles.reserve(mesh.triangles.size());
   for (const auto& t : mesh.triangles)
-    triangles.emplace_back(t[0], t[1], t[2]);
-  return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(transform, points, triangles, kLevelSetHalfWidth);
+    out.triangles.emplace_back(t[0], t[1], t[2]);
+  return out;
+}
+
+openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::Transform& transform) {
+  const OpenVdbMesh vdb = toOpenVdb(mesh);
+  return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(transform, vdb.points, vdb.triangles,
+                                                            kLevelSetHalfWidth);
 }
 
 bool isClosedSolid(const TriangleMesh& mesh) {

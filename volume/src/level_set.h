@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <utility>
+#include <vector>
 
 #include <openvdb/openvdb.h>
 
@@ -15,6 +16,14 @@ namespace shapedb::volume::detail {
 
 /// Narrow band half-width, voxels, of every level set made here.
 inline constexpr float kLevelSetHalfWidth = 3.0f;
+
+/// A triangle mesh as OpenVDB's mesh tools take it: single-precision points (the caller keeps them near
+/// the origin of a local frame) and index triples.
+struct OpenVdbMesh {
+  std::vector<openvdb::Vec3s> points;
+  std::vector<openvdb::Vec3I> triangles;
+};
+OpenVdbMesh toOpenVdb(const core::TriangleMesh& mesh);
 
 /// The level set of a closed, outward-wound surface in `transform`'s voxels (its points go through
 /// single precision: the caller keeps them near the origin of a local frame).
