@@ -30,6 +30,18 @@ if(NOT TARGET TetGen::tet)
     INTERFACE_INCLUDE_DIRECTORIES "${TETGEN_INCLUDE_DIR}"
     INTERFACE_COMPILE_DEFINITIONS TETLIBRARY)
 endif()
+# CHOLMOD (SuiteSparse), the supernodal sparse Cholesky of the modal analysis: Debian 12's package has
+# neither a CMake package nor pkg-config files.
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY NAMES cholmod REQUIRED)
+find_library(SUITESPARSE_CONFIG_LIBRARY NAMES suitesparseconfig REQUIRED)
+if(NOT TARGET SuiteSparse::cholmod)
+  add_library(SuiteSparse::cholmod UNKNOWN IMPORTED)
+  set_target_properties(SuiteSparse::cholmod PROPERTIES
+    IMPORTED_LOCATION "${CHOLMOD_LIBRARY}"
+    INTERFACE_INCLUDE_DIRECTORIES "${CHOLMOD_INCLUDE_DIR}"
+    INTERFACE_LINK_LIBRARIES "${SUITESPARSE_CONFIG_LIBRARY}")
+endif()
 
 if(SHAPEDB_BUILD_TESTS)
   find_package(GTest CONFIG REQUIRED)

@@ -13,6 +13,7 @@ packages=(
   libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev libtet1.5-dev libeigen3-dev
   libopenmesh-dev libspectra-dev libgtest-dev googletest libbenchmark-dev libcli11-dev
   nlohmann-json3-dev libsqlite3-dev libstb-dev zlib1g-dev sqlite3 libbullet-dev
+  libsuitesparse-dev libblis4-serial
 )
 # The fuzz preset builds with Clang and links libFuzzer.
 [ "$preset" = fuzz ] && packages+=(clang-14 libclang-rt-14-dev)

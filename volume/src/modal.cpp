@@ -7,11 +7,12 @@
 
 #include <Eigen/Dense>
 #include <Eigen/OrderingMethods>
-#include <Eigen/SparseCholesky>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <shapedb/volume/modal.h>
+
+#include "sparse_cholesky.h"
 
 namespace shapedb::volume {
 namespace {
@@ -21,35 +22,34 @@ using core::TetMesh;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 /// A fill-reducing ordering for matrices of 3 × 3 blocks (a node's x, y, z): approximate minimum degree
-/// on the graph of the nodes, each node's three rows kept together. The same fill as AMD on the scalar
-/// graph here, in half the analysis time (the node graph has a ninth of the entries).
-struct NodeBlockAmdOrdering {
-  using PermutationType = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
-  template <typename MatrixType>
-  void operator()(const MatrixType& matrix, PermutationType& permutation) {
-    const Eigen::Index nodes = matrix.rows() / 3;
-    std::vector<Eigen::Triplet<double, int>> pattern;
-    pattern.reserve(static_cast<std::size_t>(matrix.nonZeros() / 9 + nodes));
-    for (Eigen::Index column = 0; column < matrix.outerSize(); column += 3)
-      for (typename MatrixType::InnerIterator it(matrix, column); it; ++it)
-        if (it.row() % 3 == 0)
-          pattern.emplace_back(static_cast<int>(it.row() / 3), static_cast<int>(column / 3), 1.0);
-    Eigen::SparseMatrix<double, Eigen::ColMajor, int> graph(nodes, nodes);
-    graph.setFromTriplets(pattern.begin(), pattern.end());
-    PermutationType nodeOrder;
-    Eigen::AMDOrdering<int>()(graph, nodeOrder);
-    permutation.resize(3 * nodes);
-    for (Eigen::Index i = 0; i < nodes; ++i)
-      for (int c = 0; c < 3; ++c)
-        permutation.indices()[3 * i + c] = 3 * nodeOrder.indices()[i] + c;
-  }
-};
+/// on the graph of the nodes, each node's three rows kept together; order[k] is the row eliminated k-th.
+/// The same fill as AMD on the scalar graph here, in a fraction of the analysis time (the node graph has a
+/// ninth of the entries).
+std::vector<int> nodeBlockOrder(const SparseMatrix& matrix) {
+  const Eigen::Index nodes = matrix.rows() / 3;
+  std::vector<Eigen::Triplet<double, int>> pattern;
+  pattern.reserve(static_cast<std::size_t>(matrix.nonZeros() / 9 + nodes));
+  for (Eigen::Index column = 0; column < matrix.outerSize(); column += 3)
+    for (SparseMatrix::InnerIterator it(matrix, column); it; ++it)
+      if (it.row() % 3 == 0)
+        pattern.emplace_back(static_cast<int>(it.row() / 3), static_cast<int>(column / 3), 1.0);
+  SparseMatrix graph(nodes, nodes);
+  graph.setFromTriplets(pattern.begin(), pattern.end());
+  // Eigen's orderings return the inverse permutation: its k-th index is the node eliminated k-th.
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> nodeOrder;
+  Eigen::AMDOrdering<int>()(graph, nodeOrder);
+  std::vector<int> order(static_cast<std::size_t>(3 * nodes));
+  for (Eigen::Index i = 0; i < nodes; ++i)
+    for (int c = 0; c < 3; ++c)
+      order[static_cast<std::size_t>(3 * i + c)] = 3 * nodeOrder.indices()[i] + c;
+  return order;
+}
 
-/// y = P (K − σM)⁻¹ x for Spectra's shift-invert mode, by a sparse LDLᵀ of K − σM (symmetric positive
-/// definite for σ < 0: K is semi-definite and M definite; Spectra's own SymShiftInvert uses sparse LU,
-/// about twice the work). P = I − R Rᵀ M removes the rigid motions R (M-orthonormal): Lanczos then never
-/// meets the six-fold eigenvalue of the rigid modes, which it can resolve short of one (it did, on a
-/// 3,500-node beam), and spends no iterations on them.
+/// y = P (K − σM)⁻¹ x for Spectra's shift-invert mode, by a supernodal sparse Cholesky factorization of
+/// K − σM (symmetric positive definite for σ < 0: K is semi-definite and M definite; Spectra's own
+/// SymShiftInvert uses sparse LU, about twice the work). P = I − R Rᵀ M removes the rigid motions R
+/// (M-orthonormal): Lanczos then never meets the six-fold eigenvalue of the rigid modes, which it can resolve
+/// short of one (it did, on a 3,500-node beam), and spends no iterations on them.
 class ShiftInvertLdlt {
  public:
   using Scalar = double;
@@ -58,13 +58,13 @@ class ShiftInvertLdlt {
   Eigen::Index rows() const { return mK.rows(); }
   Eigen::Index cols() const { return mK.cols(); }
   void set_shift(double sigma) {  // NOLINT: Spectra's interface
-    mSolver.compute(mK - sigma * mM);
-    mOk = mSolver.info() == Eigen::Success;
+    SparseMatrix shifted = mK - sigma * mM;
+    shifted.makeCompressed();
+    mOk = mSolver.factorize(shifted, nodeBlockOrder(shifted));
   }
   void perform_op(const double* in, double* out) const {  // NOLINT: Spectra's interface
-    Eigen::Map<const Eigen::VectorXd> x(in, mK.rows());
+    mSolver.solve(in, out);                               // NaN if it failed: Lanczos then fails, and says so
     Eigen::Map<Eigen::VectorXd> y(out, mK.rows());
-    y.noalias() = mSolver.solve(x);
     y.noalias() -= mRigid * (mMRigid.transpose() * y);
   }
   bool ok() const { return mOk; }
@@ -74,7 +74,7 @@ class ShiftInvertLdlt {
   const SparseMatrix& mM;
   const Eigen::MatrixXd& mRigid;
   const Eigen::MatrixXd mMRigid;
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, NodeBlockAmdOrdering> mSolver;
+  detail::SparseCholesky mSolver;
   bool mOk = false;
 };
 

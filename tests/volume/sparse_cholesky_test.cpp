@@ -1,0 +1,128 @@
+// The supernodal Cholesky factorization (CHOLMOD) of the modal analysis, against Eigen's dense LLᵀ.
+
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <gtest/gtest.h>
+
+// A private header of the volume module (volume/src): this test reaches it on its include path.
+#include "sparse_cholesky.h"
+
+namespace shapedb::volume::detail {
+namespace {
+
+/// A symmetric positive definite matrix with the structure of an FEM matrix: 3 × 3 blocks coupling the
+/// nodes of a grid of `side`³ nodes to their neighbours, random values, made definite by its diagonal.
+Eigen::SparseMatrix<double> gridMatrix(int side, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  const auto node = [side](int x, int y, int z) { return (x * side + y) * side + z; };
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int x = 0; x < side; ++x)
+    for (int y = 0; y < side; ++y)
+      for (int z = 0; z < side; ++z)
+        for (int dx = 0; dx <= 1; ++dx)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz) {
+              if (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0))) continue;  // each pair once
+              if (x + dx >= side || y + dy < 0 || y + dy >= side || z + dz < 0 || z + dz >= side) continue;
+              const int a = node(x, y, z), b = node(x + dx, y + dy, z + dz);
+              for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) {
+                  const double v = value(rng);
+                  entries.emplace_back(3 * a + i, 3 * b + j, v);
+                  entries.emplace_back(3 * b + j, 3 * a + i, v);
+                }
+            }
+  const int n = 3 * side * side * side;
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(entries.begin(), entries.end());
+  // Diagonally dominant: definite.
+  Eigen::VectorXd rowSum = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < m.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(m, k); it; ++it)
+      rowSum[it.row()] += std::abs(it.value());
+  for (int i = 0; i < n; ++i)
+    m.coeffRef(i, i) += rowSum[i] + 0.1;
+  m.makeCompressed();
+  return m;
+}
+
+TEST(SparseCholesky, SolvesAsTheDenseCholeskyForRandomMatricesOrdersAndRightHandSides) {
+  std::mt19937_64 rng(5);
+  for (int side : {2, 3, 5, 7}) {
+    const Eigen::SparseMatrix<double> a = gridMatrix(side, rng);
+    const Eigen::MatrixXd dense(a);
+    const Eigen::LLT<Eigen::MatrixXd> oracle(dense);
+    ASSERT_EQ(oracle.info(), Eigen::Success);
+    // CHOLMOD's own ordering, and a random one given to it.
+    std::vector<int> order(static_cast<std::size_t>(a.rows()));
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    for (const std::vector<int>& given : {std::vector<int>{}, order}) {
+      SparseCholesky cholesky;
+      ASSERT_TRUE(cholesky.factorize(a, given)) << "side " << side;
+      ASSERT_EQ(cholesky.rows(), a.rows());
+      for (Eigen::Index columns : {1, 7}) {
+        const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), columns);
+        const Eigen::MatrixXd x = cholesky.solve(b);
+        const Eigen::MatrixXd expected = oracle.solve(b);
+        EXPECT_LT((x - expected).norm(), 1e-10 * expected.norm())
+            << "side " << side << ", " << columns << " columns, " << (given.empty() ? "own" : "given")
+            << " order";
+      }
+    }
+  }
+}
+
+TEST(SparseCholesky, AnIndefiniteOrMalformedMatrixIsRefused) {
+  std::mt19937_64 rng(6);
+  Eigen::SparseMatrix<double> a = gridMatrix(3, rng);
+  a.coeffRef(10, 10) = -1e3;  // a negative pivot
+  SparseCholesky cholesky;
+  EXPECT_FALSE(cholesky.factorize(a));
+  EXPECT_EQ(cholesky.rows(), 0);
+  Eigen::SparseMatrix<double> rectangular(6, 3);
+  rectangular.makeCompressed();
+  EXPECT_FALSE(cholesky.factorize(rectangular));
+  const Eigen::SparseMatrix<double> b = gridMatrix(2, rng);
+  EXPECT_FALSE(cholesky.factorize(b, {0, 1, 2})) << "an order of the wrong size";
+  EXPECT_TRUE(cholesky.factorize(b)) << "the same object factorizes again";
+}
+
+// The database build factorizes on every worker thread at once, through whichever BLAS the system has:
+// each thread's results must be those of the same work done alone.
+TEST(SparseCholesky, ConcurrentFactorizationsAndSolvesEqualSerialOnes) {
+  constexpr int kThreads = 4, kMatrices = 3;
+  std::vector<Eigen::SparseMatrix<double>> matrices;
+  std::vector<Eigen::MatrixXd> rhs;
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < kThreads * kMatrices; ++i) {
+    matrices.push_back(gridMatrix(7 + i % 2, rng));  // 1,029 or 1,536 rows: supernodes go through BLAS
+    rhs.push_back(Eigen::MatrixXd::Random(matrices.back().rows(), 3));
+  }
+  const auto solveAll = [&](int first, int step, std::vector<Eigen::MatrixXd>& out) {
+    for (std::size_t i = static_cast<std::size_t>(first); i < matrices.size();
+         i += static_cast<std::size_t>(step)) {
+      SparseCholesky cholesky;
+      out[i] = cholesky.factorize(matrices[i]) ? cholesky.solve(rhs[i]) : Eigen::MatrixXd();
+    }
+  };
+  std::vector<Eigen::MatrixXd> serial(matrices.size()), concurrent(matrices.size());
+  solveAll(0, 1, serial);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] { solveAll(t, kThreads, concurrent); });
+  for (std::thread& t : threads)
+    t.join();
+  for (std::size_t i = 0; i < matrices.size(); ++i) {
+    ASSERT_GT(serial[i].size(), 0) << "matrix " << i;
+    EXPECT_EQ(concurrent[i], serial[i]) << "matrix " << i;
+  }
+}
+
+}  // namespace
+}  // namespace shapedb::volume::detail

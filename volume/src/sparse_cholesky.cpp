@@ -1,0 +1,125 @@
+#include "sparse_cholesky.h"
+
+#include <algorithm>
+#include <cholmod.h>
+#include <cstring>
+#include <dlfcn.h>
+#include <limits>
+#include <mutex>
+
+namespace shapedb::volume::detail {
+namespace {
+
+/// CHOLMOD's dense blocks go through whichever BLAS and LAPACK the system provides. Most are safe to call
+/// from several threads at once (the reference ones, BLIS, OpenBLAS built for threads); a sequential
+/// OpenBLAS built without locking (Debian's libopenblas0-serial) is not: concurrent factorizations then
+/// fail at random, or worse. Where that library is the one loaded, the factorizations and solves of all
+/// threads take turns; elsewhere this lock is never taken.
+std::mutex* blasLock() {
+  static std::mutex* const lock = []() -> std::mutex* {
+    using Query = int (*)();
+    const auto parallel = reinterpret_cast<Query>(::dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+    return parallel && parallel() == 0 ? new std::mutex : nullptr;  // 0: sequential OpenBLAS
+  }();
+  return lock;
+}
+
+std::unique_lock<std::mutex> lockBlas() {
+  std::mutex* lock = blasLock();
+  return lock ? std::unique_lock<std::mutex>(*lock) : std::unique_lock<std::mutex>();
+}
+
+}  // namespace
+
+/// CHOLMOD's state: its workspace (`common`), the factor, and the dense buffers cholmod_solve2 reuses from
+/// one solve to the next (mutable: a solve changes no result, only scratch space).
+struct SparseCholesky::Impl {
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+  mutable cholmod_dense* x = nullptr;
+  mutable cholmod_dense* y = nullptr;
+  mutable cholmod_dense* e = nullptr;
+
+  Impl() {
+    cholmod_start(&common);
+    common.print = 0;  // errors are returned to the caller, not printed
+    common.supernodal = CHOLMOD_SUPERNODAL;
+    common.quick_return_if_not_posdef = 1;
+  }
+  ~Impl() {
+    freeFactor();
+    cholmod_finish(&common);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  void freeFactor() {
+    if (factor) cholmod_free_factor(&factor, &common);
+    for (cholmod_dense** d : {&x, &y, &e})
+      if (*d) cholmod_free_dense(d, &common);
+  }
+};
+
+SparseCholesky::SparseCholesky() : mImpl(std::make_unique<Impl>()) {}
+SparseCholesky::~SparseCholesky() = default;
+
+bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order) {
+  Impl& s = *mImpl;
+  s.freeFactor();
+  mRows = 0;
+  if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return false;
+  if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return false;
+  // A view of the matrix: CHOLMOD reads it, and with stype −1 only its lower triangle.
+  cholmod_sparse a{};
+  a.nrow = a.ncol = static_cast<std::size_t>(matrix.rows());
+  a.nzmax = static_cast<std::size_t>(matrix.nonZeros());
+  a.p = const_cast<int*>(matrix.outerIndexPtr());
+  a.i = const_cast<int*>(matrix.innerIndexPtr());
+  a.x = const_cast<double*>(matrix.valuePtr());
+  a.stype = -1;
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_REAL;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 1;
+  a.packed = 1;
+  s.common.nmethods = 1;
+  s.common.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
+  s.common.postorder = 1;
+  const std::unique_lock<std::mutex> lock = lockBlas();
+  s.factor =
+      cholmod_analyze_p(&a, order.empty() ? nullptr : const_cast<int*>(order.data()), nullptr, 0, &s.common);
+  if (!s.factor) return false;
+  if (!cholmod_factorize(&a, s.factor, &s.common) || s.common.status != CHOLMOD_OK ||
+      s.factor->minor < s.factor->n) {
+    s.freeFactor();
+    return false;
+  }
+  mRows = matrix.rows();
+  return true;
+}
+
+bool SparseCholesky::solve(const double* b, double* x, Eigen::Index columns) const {
+  const Impl& s = *mImpl;
+  cholmod_dense rhs{};
+  rhs.nrow = rhs.d = static_cast<std::size_t>(mRows);
+  rhs.ncol = static_cast<std::size_t>(columns);
+  rhs.nzmax = rhs.nrow * rhs.ncol;
+  rhs.x = const_cast<double*>(b);
+  rhs.xtype = CHOLMOD_REAL;
+  rhs.dtype = CHOLMOD_DOUBLE;
+  auto& common = const_cast<cholmod_common&>(s.common);
+  const std::unique_lock<std::mutex> lock = lockBlas();
+  if (!s.factor || !cholmod_solve2(CHOLMOD_A, s.factor, &rhs, nullptr, &s.x, nullptr, &s.y, &s.e, &common)) {
+    std::fill(x, x + rhs.nzmax, std::numeric_limits<double>::quiet_NaN());
+    return false;
+  }
+  std::memcpy(x, s.x->x, sizeof(double) * rhs.nzmax);
+  return true;
+}
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
+  Eigen::MatrixXd x(b.rows(), b.cols());
+  solve(b.data(), x.data(), b.cols());
+  return x;
+}
+
+}  // namespace shapedb::volume::detail
