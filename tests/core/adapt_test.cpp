@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <shapedb/core/adapt.h>
-#include <shapedb/core/fidelity.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/spatial.h>
 
@@ -14,118 +13,9 @@
 namespace shapedb::core {
 namespace {
 
-/// A box [0,nx]×[0,ny]×[0,nz] of unit cubes, each split into six tets around its main diagonal (Kuhn),
-/// interior nodes jittered by up to `jitter`: a conforming tet mesh with irregular tets.
-TetMesh makeTetGrid(int nx, int ny, int nz, double jitter, std::mt19937_64& rng) {
-  TetMesh mesh;
-  std::uniform_real_distribution<double> u(-jitter, jitter);
-  const auto id = [&](int x, int y, int z) {
-    return static_cast<std::uint32_t>((z * (ny + 1) + y) * (nx + 1) + x);
-  };
-  for (int z = 0; z <= nz; ++z)
-    for (int y = 0; y <= ny; ++y)
-      for (int x = 0; x <= nx; ++x) {
-        Vec3 p(x, y, z);
-        for (int a = 0; a < 3; ++a) {
-          const int i = a == 0 ? x : a == 1 ? y : z, n = a == 0 ? nx : a == 1 ? ny : nz;
-          if (i > 0 && i < n) p[a] += u(rng);
-        }
-        mesh.nodes.push_back(p);
-      }
-  static constexpr int kPaths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x)
-        for (const auto& path : kPaths) {
-          std::array<int, 3> c{x, y, z};
-          TetMesh::Tet t;
-          t[0] = id(c[0], c[1], c[2]);
-          for (int k = 0; k < 3; ++k) {
-            ++c[path[k]];
-            t[k + 1] = id(c[0], c[1], c[2]);
-          }
-          if (tetVolume(TetMesh{mesh.nodes, {t}}, 0) < 0) std::swap(t[2], t[3]);
-          mesh.tets.push_back(t);
-        }
-  return mesh;
-}
-
-Vec3 interpolate(const TetMesh& mesh, const TetLocation& l) {
-  Vec3 x = Vec3::Zero();
-  for (int k = 0; k < 4; ++k)
-    x += l.weights[k] * mesh.nodes[mesh.tets[l.tet][k]];
-  return x;
-}
-
-TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
-  std::mt19937_64 rng(7);
-  const TriangleMesh surface =
-      transformed(makeUvEllipsoid({1.0, 0.6, 0.3}, 24, 12), test::randomSimilarity(rng));
-  const ClosestPointTree tree(surface);
-  const Bounds b = computeBounds(surface);
-  std::uniform_real_distribution<double> u(-0.5, 1.5);
-  std::uint32_t previous = 0;
-  for (int i = 0; i < 2000; ++i) {
-    const Vec3 p = b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent());
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& t : surface.triangles)
-      best = std::min(best, closestPointOnTriangle(p, surface.vertices[t[0]], surface.vertices[t[1]],
-                                                   surface.vertices[t[2]])
-                                .squaredDistance);
-    // Unhinted, hinted by the previous point's answer, and hinted by an arbitrary triangle.
-    const std::uint32_t arbitrary = static_cast<std::uint32_t>(rng() % surface.triangles.size());
-    for (const auto& hit : {tree.closest(p), tree.closest(p, previous), tree.closest(p, arbitrary)}) {
-      ASSERT_NEAR(hit.closest.squaredDistance, best, 1e-12 * (1 + best)) << "point " << i;
-      const auto& t = surface.triangles[hit.triangle];
-      const auto& w = hit.closest.barycentric;
-      const Vec3 q =
-          w[0] * surface.vertices[t[0]] + w[1] * surface.vertices[t[1]] + w[2] * surface.vertices[t[2]];
-      ASSERT_LT((q - hit.closest.point).norm(), 1e-9);
-    }
-    previous = tree.closest(p).triangle;
-  }
-}
-
-TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
-  std::mt19937_64 rng(11);
-  const TetMesh mesh = makeTetGrid(6, 4, 3, 0.3, rng);
-  ASSERT_TRUE(validateTetMesh(mesh));
-  const TetLocator locator(mesh);
-  EXPECT_EQ(locator.boundary().triangleCount(), 2u * 2 * (6 * 4 + 4 * 3 + 6 * 3));
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  int inside = 0;
-  TetLocator::Hint hint;
-  for (int i = 0; i < 8000; ++i) {
-    const Vec3 p(3 + 4.5 * u(rng), 2 + 3.5 * u(rng), 1.5 + 3 * u(rng));
-    // Even points with odd ones: a hint from an unrelated point must not change the answer.
-    const TetLocation fast = i % 2 == 0 ? locator.locate(p) : locator.locate(p, hint);
-    const TetLocation slow = locateBruteForce(locator, p);
-    double sum = 0.0;
-    for (double w : fast.weights) {
-      ASSERT_GT(w, -1e-9);
-      sum += w;
-    }
-    ASSERT_NEAR(sum, 1.0, 1e-12);
-    ASSERT_EQ(fast.inside(), slow.inside()) << "point " << i;
-    if (fast.inside()) {
-      ++inside;
-      ASSERT_EQ(fast.tet, slow.tet);
-      ASSERT_LT((interpolate(mesh, fast) - p).norm(), 1e-12) << "an inside point is its weighted nodes";
-    } else {
-      // Several faces can be equally close (an edge, a corner): compare the distance and the point.
-      ASSERT_NEAR(fast.distance, slow.distance, 1e-12);
-      ASSERT_LT((interpolate(mesh, fast) - interpolate(mesh, slow)).norm(), 1e-9);
-      ASSERT_NEAR((interpolate(mesh, fast) - p).norm(), fast.distance, 1e-9);
-    }
-  }
-  // The grid fills 72 of the sampled 378 units³: about 1,520 points inside, the rest outside.
-  EXPECT_GT(inside, 1000);
-  EXPECT_LT(inside, 2000);
-}
-
 TEST(Link, WeightsSumToOneAndReproduceInsideVertices) {
   std::mt19937_64 rng(3);
-  const TetMesh mesh = makeTetGrid(5, 5, 5, 0.25, rng);
+  const TetMesh mesh = test::makeTetGrid(5, 5, 5, 0.25, rng);
   const TetLocator locator(mesh);
   // A placement of scale 2, turned and moved: the "query" lives in another frame than the entry.
   Placement placement{test::randomRotation(rng), Vec3(1, -2, 3), 2.0};
@@ -142,7 +32,7 @@ TEST(Link, WeightsSumToOneAndReproduceInsideVertices) {
   for (std::size_t i = 0; i < vertices.size(); ++i) {
     const TetLocation& l = link.locations[i];
     ASSERT_NEAR(l.weights[0] + l.weights[1] + l.weights[2] + l.weights[3], 1.0, 1e-12);
-    const double error = (interpolate(placed, l) - vertices[i]).norm();
+    const double error = (test::interpolate(placed, l) - vertices[i]).norm();
     if (l.inside()) {
       ASSERT_LT(error, 1e-11);
     } else {
@@ -166,7 +56,7 @@ TEST(Link, WeightsSumToOneAndReproduceInsideVertices) {
 TEST(Adapt, ScalesMassFrequenciesAndModesAndPlacesTheTets) {
   std::mt19937_64 rng(5);
   PhysicalData entry;
-  entry.tetMesh = makeTetGrid(2, 2, 2, 0.1, rng);
+  entry.tetMesh = test::makeTetGrid(2, 2, 2, 0.1, rng);
   for (Vec3& x : entry.tetMesh.nodes)
     x = (x - Vec3::Constant(1.0)) / 2.0;  // unit volume, centred
   entry.massProperties = computeTetMassProperties(entry.tetMesh);
@@ -227,43 +117,6 @@ TEST(Adapt, ScalesMassFrequenciesAndModesAndPlacesTheTets) {
   EXPECT_EQ(r->warnings.size(), 1u) << "rubber's Poisson ratio is not the database's";
   EXPECT_FALSE(materialPreset("unobtainium"));
   EXPECT_FALSE(adapt(entry, q, qm, orientation, Material{"bad", -1.0, 1.0, 0.3}, {}));
-}
-
-TEST(Fidelity, ZeroForTheSameShapeAndGrowsWithTheDifference) {
-  std::mt19937_64 rng(9);
-  // The same unit cube as entry (tets) and as query (surface), the query turned, moved and scaled.
-  TetMesh tets = makeTetGrid(3, 3, 3, 0.0, rng);
-  for (Vec3& x : tets.nodes)
-    x = (x - Vec3::Constant(1.5)) / 3.0;
-  const TetLocator locator(tets);
-  const MassProperties entryMass = computeTetMassProperties(tets);
-  const double L = 2.0;
-  const Mat3 R = test::randomRotation(rng);
-  Normalization q;
-  q.scale = 1.0 / L;
-  q.principalAxes = R;
-  q.meshFromCanonical.topRightCorner<3, 1>() = Vec3(1, 2, 3);
-  q.canonicalMoments = Vec3::Constant(1.0 / 6.0);
-  const Placement placement = placementOf(q, Mat3::Identity());
-  TriangleMesh query = locator.boundary();
-  for (Vec3& v : query.vertices)
-    v = placement.toQuery(v);
-  const Fidelity same = assessFidelity(query, ClosestPointTree(query), q, locator, entryMass, placement, 0.0);
-  EXPECT_LT(same.maxDeviation, 1e-12);
-  EXPECT_LT(same.maxMomentError, 1e-12);
-  EXPECT_EQ(same.samples, 2048);
-
-  // Stretch the query by 10 % along one axis: deviations of a few per cent of L, moments off.
-  TriangleMesh stretched = query;
-  for (Vec3& v : stretched.vertices)
-    v = Vec3(1, 2, 3) + R * (Vec3(1.1, 1.0, 1.0).asDiagonal() * (R.transpose() * (v - Vec3(1, 2, 3))));
-  q.canonicalMoments = Vec3(1.0, 1.0, 1.0);  // any different moments
-  const Fidelity off =
-      assessFidelity(stretched, ClosestPointTree(stretched), q, locator, entryMass, placement, 0.3);
-  EXPECT_GT(off.meanDeviation, 0.005);
-  EXPECT_NEAR(off.maxDeviation, 0.05, 0.01) << "the stretched faces stand 0.1 L / 2 off the entry's";
-  EXPECT_GT(off.maxMomentError, 0.5);
-  EXPECT_DOUBLE_EQ(off.descriptorDistance, 0.3);
 }
 
 }  // namespace

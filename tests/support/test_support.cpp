@@ -1,5 +1,6 @@
 #include "support/test_support.h"
 
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cstdlib>
@@ -78,6 +79,48 @@ std::optional<std::filesystem::path> realMeshDirectory(std::string* why) {
 std::string readFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+core::TetMesh makeTetGrid(int nx, int ny, int nz, double jitter, std::mt19937_64& rng) {
+  core::TetMesh mesh;
+  std::uniform_real_distribution<double> u(-jitter, jitter);
+  const auto id = [&](int x, int y, int z) {
+    return static_cast<std::uint32_t>((z * (ny + 1) + y) * (nx + 1) + x);
+  };
+  for (int z = 0; z <= nz; ++z)
+    for (int y = 0; y <= ny; ++y)
+      for (int x = 0; x <= nx; ++x) {
+        core::Vec3 p(x, y, z);
+        for (int a = 0; a < 3; ++a) {
+          const int i = a == 0 ? x : a == 1 ? y : z, n = a == 0 ? nx : a == 1 ? ny : nz;
+          if (i > 0 && i < n) p[a] += u(rng);
+        }
+        mesh.nodes.push_back(p);
+      }
+  static constexpr int kPaths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+        for (const auto& path : kPaths) {
+          std::array<int, 3> c{x, y, z};
+          core::TetMesh::Tet t;
+          t[0] = id(c[0], c[1], c[2]);
+          for (int k = 0; k < 3; ++k) {
+            ++c[path[k]];
+            t[k + 1] = id(c[0], c[1], c[2]);
+          }
+          if (core::tetVolume(core::TetMesh{mesh.nodes, {t}}, 0) < 0) std::swap(t[2], t[3]);
+          mesh.tets.push_back(t);
+        }
+  return mesh;
+}
+
+core::Vec3 interpolate(const core::TetMesh& mesh, const core::TetLocation& location) {
+  core::Vec3 x = core::Vec3::Zero();
+  for (int k = 0; k < 4; ++k)
+    x += location.weights[static_cast<std::size_t>(k)] *
+         mesh.nodes[mesh.tets[location.tet][static_cast<std::size_t>(k)]];
+  return x;
 }
 
 }  // namespace shapedb::test

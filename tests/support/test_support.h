@@ -7,6 +7,8 @@
 #include <random>
 #include <string>
 
+#include <shapedb/core/physics.h>
+#include <shapedb/core/spatial.h>
 #include <shapedb/core/triangle_mesh.h>
 #include <shapedb/core/types.h>
 
@@ -49,6 +51,13 @@ std::optional<std::filesystem::path> realMeshDirectory(std::string* why = nullpt
   const std::optional<std::filesystem::path> var##Found = ::shapedb::test::realMeshDirectory(&var##Why); \
   if (!var##Found) GTEST_SKIP() << var##Why;                                                             \
   const std::filesystem::path var = *var##Found
+
+/// A box [0,nx]×[0,ny]×[0,nz] of unit cubes, each split into six tets around its main diagonal (Kuhn),
+/// interior nodes jittered by up to `jitter`: a conforming tet mesh with irregular tets.
+core::TetMesh makeTetGrid(int nx, int ny, int nz, double jitter, std::mt19937_64& rng);
+
+/// The point a location's barycentric weights give on `mesh`'s nodes.
+core::Vec3 interpolate(const core::TetMesh& mesh, const core::TetLocation& location);
 
 /// Writes `content` to `path` byte for byte.
 void writeFile(const std::filesystem::path& path, const std::string& content);

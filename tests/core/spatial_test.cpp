@@ -1,0 +1,85 @@
+// The spatial searches against brute force: the closest point on a surface (ClosestPointTree) and the
+// tet holding a point, or the nearest boundary point outside (TetLocator).
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/core/spatial.h>
+
+#include "test_support.h"
+
+namespace shapedb::core {
+namespace {
+
+TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
+  std::mt19937_64 rng(7);
+  const TriangleMesh surface =
+      transformed(makeUvEllipsoid({1.0, 0.6, 0.3}, 24, 12), test::randomSimilarity(rng));
+  const ClosestPointTree tree(surface);
+  const Bounds b = computeBounds(surface);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  std::uint32_t previous = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 p = b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent());
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& t : surface.triangles)
+      best = std::min(best, closestPointOnTriangle(p, surface.vertices[t[0]], surface.vertices[t[1]],
+                                                   surface.vertices[t[2]])
+                                .squaredDistance);
+    // Unhinted, hinted by the previous point's answer, and hinted by an arbitrary triangle.
+    const std::uint32_t arbitrary = static_cast<std::uint32_t>(rng() % surface.triangles.size());
+    for (const auto& hit : {tree.closest(p), tree.closest(p, previous), tree.closest(p, arbitrary)}) {
+      ASSERT_NEAR(hit.closest.squaredDistance, best, 1e-12 * (1 + best)) << "point " << i;
+      const auto& t = surface.triangles[hit.triangle];
+      const auto& w = hit.closest.barycentric;
+      const Vec3 q =
+          w[0] * surface.vertices[t[0]] + w[1] * surface.vertices[t[1]] + w[2] * surface.vertices[t[2]];
+      ASSERT_LT((q - hit.closest.point).norm(), 1e-9);
+    }
+    previous = tree.closest(p).triangle;
+  }
+}
+
+TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
+  std::mt19937_64 rng(11);
+  const TetMesh mesh = test::makeTetGrid(6, 4, 3, 0.3, rng);
+  ASSERT_TRUE(validateTetMesh(mesh));
+  const TetLocator locator(mesh);
+  EXPECT_EQ(locator.boundary().triangleCount(), 2u * 2 * (6 * 4 + 4 * 3 + 6 * 3));
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int inside = 0;
+  TetLocator::Hint hint;
+  for (int i = 0; i < 8000; ++i) {
+    const Vec3 p(3 + 4.5 * u(rng), 2 + 3.5 * u(rng), 1.5 + 3 * u(rng));
+    // Even points with odd ones: a hint from an unrelated point must not change the answer.
+    const TetLocation fast = i % 2 == 0 ? locator.locate(p) : locator.locate(p, hint);
+    const TetLocation slow = locateBruteForce(locator, p);
+    double sum = 0.0;
+    for (double w : fast.weights) {
+      ASSERT_GT(w, -1e-9);
+      sum += w;
+    }
+    ASSERT_NEAR(sum, 1.0, 1e-12);
+    ASSERT_EQ(fast.inside(), slow.inside()) << "point " << i;
+    if (fast.inside()) {
+      ++inside;
+      ASSERT_EQ(fast.tet, slow.tet);
+      ASSERT_LT((test::interpolate(mesh, fast) - p).norm(), 1e-12) << "an inside point is its weighted nodes";
+    } else {
+      // Several faces can be equally close (an edge, a corner): compare the distance and the point.
+      ASSERT_NEAR(fast.distance, slow.distance, 1e-12);
+      ASSERT_LT((test::interpolate(mesh, fast) - test::interpolate(mesh, slow)).norm(), 1e-9);
+      ASSERT_NEAR((test::interpolate(mesh, fast) - p).norm(), fast.distance, 1e-9);
+    }
+  }
+  // The grid fills 72 of the sampled 378 units³: about 1,520 points inside, the rest outside.
+  EXPECT_GT(inside, 1000);
+  EXPECT_LT(inside, 2000);
+}
+
+}  // namespace
+}  // namespace shapedb::core
