@@ -1,279 +1,22 @@
+// What tetrahedralize asks TetGen and how it checks the answer; the process that runs TetGen is
+// tetgen_worker.cpp's.
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
 #include <string>
-#include <sys/socket.h>
-#include <sys/syscall.h>
-#include <sys/types.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
-
-#include <tetgen.h>
 
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/tetrahedralize.h>
 
+#include "tetgen_worker.h"
+
 namespace shapedb::volume {
-namespace {
 
 using core::TetMesh;
 using core::TriangleMesh;
-
-/// TetGen's output, or why there is none: the plain-data form that crosses the pipe from the child.
-struct RawResult {
-  std::int32_t status = 0;  ///< 0 ok; otherwise TetGen's error code (its terminatetetgen argument)
-  std::vector<double> nodes;
-  std::vector<std::int32_t> tets;
-};
-
-/// Runs TetGen in this process. TetGen reports errors by throwing an int (TETLIBRARY builds).
-RawResult runTetGen(const TriangleMesh& surface, const std::string& switches) {
-  tetgenio in, out;
-  in.firstnumber = 0;
-  in.numberofpoints = static_cast<int>(surface.vertices.size());
-  in.pointlist = new REAL[3 * surface.vertices.size()];
-  for (std::size_t i = 0; i < surface.vertices.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      in.pointlist[3 * i + static_cast<std::size_t>(k)] = surface.vertices[i][k];
-  in.numberoffacets = static_cast<int>(surface.triangles.size());
-  in.facetlist = new tetgenio::facet[surface.triangles.size()];
-  for (std::size_t f = 0; f < surface.triangles.size(); ++f) {
-    tetgenio::facet& facet = in.facetlist[f];
-    tetgenio::init(&facet);
-    facet.numberofpolygons = 1;
-    facet.polygonlist = new tetgenio::polygon[1];
-    tetgenio::init(&facet.polygonlist[0]);
-    facet.polygonlist[0].numberofvertices = 3;
-    facet.polygonlist[0].vertexlist = new int[3];
-    for (int k = 0; k < 3; ++k)
-      facet.polygonlist[0].vertexlist[k] =
-          static_cast<int>(surface.triangles[f][static_cast<std::size_t>(k)]);
-  }
-
-  RawResult result;
-  std::vector<char> writable(switches.begin(), switches.end());
-  writable.push_back('\0');
-  try {
-    tetrahedralize(writable.data(), &in, &out);
-  } catch (int code) {
-    result.status = code == 0 ? -1 : code;
-    return result;
-  }
-  if (out.numberoftetrahedra <= 0 || out.numberofcorners != 4) {
-    result.status = -1;
-    return result;
-  }
-  result.nodes.assign(out.pointlist, out.pointlist + 3 * out.numberofpoints);
-  result.tets.assign(out.tetrahedronlist, out.tetrahedronlist + 4 * out.numberoftetrahedra);
-  return result;
-}
-
-/// Sends all bytes on a socket; MSG_NOSIGNAL: a dead peer is an error, not a SIGPIPE.
-bool sendAll(int fd, const void* data, std::size_t bytes) {
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::send(fd, p, bytes, MSG_NOSIGNAL);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-using Deadline = std::chrono::steady_clock::time_point;
-
-// testing::killNextTetGenWorkers: how many requests are still to find their worker killed.
-std::atomic<int> gWorkersToKill{0};
-
-bool takeInjectedKill() {
-  int left = gWorkersToKill.load();
-  while (left > 0 && !gWorkersToKill.compare_exchange_weak(left, left - 1)) {
-  }
-  return left > 0;
-}
-
-/// Receives exactly `bytes`, waiting until the deadline. False on end of stream, error or timeout.
-bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline, bool& timedOut) {
-  char* p = static_cast<char*>(data);
-  while (bytes > 0) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now())
-            .count();
-    if (left <= 0) return !(timedOut = true);
-    pollfd pfd{fd, POLLIN, 0};
-    const int ready = ::poll(&pfd, 1, static_cast<int>(std::min<long long>(left, 1000)));
-    if (ready < 0 && errno != EINTR) return false;
-    if (ready <= 0) continue;
-    const ssize_t n = ::recv(fd, p, bytes, 0);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-/// The child's side: requests in (switches, vertices, triangles), RawResults out, until the parent
-/// closes the socket. Never returns.
-[[noreturn]] void serveTetGen(int fd) {
-  const Deadline never = std::chrono::steady_clock::time_point::max();
-  for (;;) {
-    bool timedOut = false;
-    std::uint64_t header[3];  // switches length, vertex count, triangle count
-    if (!receiveAll(fd, header, sizeof header, never, timedOut)) ::_exit(0);
-    std::string switches(header[0], '\0');
-    TriangleMesh surface;
-    surface.vertices.resize(header[1]);
-    surface.triangles.resize(header[2]);
-    if (!receiveAll(fd, switches.data(), switches.size(), never, timedOut) ||
-        !receiveAll(fd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3), never,
-                    timedOut) ||
-        !receiveAll(fd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle),
-                    never, timedOut))
-      ::_exit(1);
-    const RawResult raw = runTetGen(surface, switches);
-    const std::int64_t reply[3] = {raw.status, static_cast<std::int64_t>(raw.nodes.size()),
-                                   static_cast<std::int64_t>(raw.tets.size())};
-    if (!sendAll(fd, reply, sizeof reply) ||
-        !sendAll(fd, raw.nodes.data(), raw.nodes.size() * sizeof(double)) ||
-        !sendAll(fd, raw.tets.data(), raw.tets.size() * sizeof(std::int32_t)))
-      ::_exit(1);
-  }
-}
-
-/// A child process that runs TetGen for one thread of the parent, request after request. Forked once and
-/// reused: a fork per call costs more than TetGen itself on small meshes (the parent's pages turn
-/// copy-on-write at every fork, and every later write to them faults). A crash or a hang in the child
-/// costs that one request: the child is reaped and the next request forks a fresh one.
-class TetGenWorker {
- public:
-  ~TetGenWorker() { stop(); }
-
-  Result<RawResult> run(const TriangleMesh& surface, const std::string& switches, double timeout) {
-    if (mPid <= 0)
-      if (Status st = start(); !st) return st.error();
-    if (takeInjectedKill()) ::kill(mPid, SIGKILL);
-    const Deadline deadline =
-        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                               std::chrono::duration<double>(timeout));
-    const std::uint64_t header[3] = {switches.size(), surface.vertices.size(), surface.triangles.size()};
-    bool timedOut = false;
-    std::int64_t reply[3] = {0, 0, 0};
-    bool ok =
-        sendAll(mFd, header, sizeof header) && sendAll(mFd, switches.data(), switches.size()) &&
-        sendAll(mFd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3)) &&
-        sendAll(mFd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle)) &&
-        receiveAll(mFd, reply, sizeof reply, deadline, timedOut);
-    RawResult raw;
-    if (ok && reply[1] >= 0 && reply[2] >= 0 && reply[1] < (std::int64_t{1} << 34) &&
-        reply[2] < (std::int64_t{1} << 34)) {
-      raw.status = static_cast<std::int32_t>(reply[0]);
-      raw.nodes.resize(static_cast<std::size_t>(reply[1]));
-      raw.tets.resize(static_cast<std::size_t>(reply[2]));
-      ok = receiveAll(mFd, raw.nodes.data(), raw.nodes.size() * sizeof(double), deadline, timedOut) &&
-           receiveAll(mFd, raw.tets.data(), raw.tets.size() * sizeof(std::int32_t), deadline, timedOut);
-    } else {
-      ok = false;
-    }
-    if (ok) return raw;
-    // The child died or hung on this input: reap it, say why, and start afresh next time.
-    const int status = stop();
-    if (timedOut)
-      return Error{ErrorCode::kIo,
-                   "TetGen did not finish within " + std::to_string(static_cast<int>(timeout)) + " s"};
-    if (WIFSIGNALED(status))
-      return Error{ErrorCode::kIo, std::string("TetGen crashed (") + ::strsignal(WTERMSIG(status)) + ")"};
-    return Error{ErrorCode::kIo, "TetGen's process failed"};
-  }
-
- private:
-  Status start() {
-    int fds[2];
-    if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
-      return Error{ErrorCode::kIo, std::string("socketpair: ") + std::strerror(errno)};
-    const pid_t pid = ::fork();
-    if (pid < 0) {
-      ::close(fds[0]);
-      ::close(fds[1]);
-      return Error{ErrorCode::kIo, std::string("fork: ") + std::strerror(errno)};
-    }
-    if (pid == 0) {
-      ::close(fds[0]);
-      // TetGen prints nothing with 'Q'; anything it or a crash report writes goes to /dev/null. The file
-      // descriptors are redirected, not the FILE streams: flushing the inherited stdout would write the
-      // parent's pending output a second time.
-      const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-      if (devnull >= 0) {
-        ::dup2(devnull, STDOUT_FILENO);
-        ::dup2(devnull, STDERR_FILENO);
-      }
-      // Keep the socket and stdio only: a descriptor inherited from the parent (another worker's socket,
-      // the database file) must not outlive the parent's own copy, or that worker never sees end of stream.
-      ::dup2(fds[1], 3);
-      ::syscall(SYS_close_range, 4u, ~0u, 0u);
-      serveTetGen(3);
-    }
-    ::close(fds[1]);
-    mFd = fds[0];
-    mPid = pid;
-    return Ok{};
-  }
-
-  /// Closes the socket, kills the child (idle, or already failed: nothing to lose) and reaps it; returns
-  /// its wait status, which says how it died if it died first.
-  int stop() {
-    int status = 0;
-    if (mFd >= 0) ::close(mFd);
-    if (mPid > 0) ::kill(mPid, SIGKILL);
-    if (mPid > 0)
-      while (::waitpid(mPid, &status, 0) < 0 && errno == EINTR) {
-      }
-    mFd = -1;
-    mPid = -1;
-    return status;
-  }
-
-  pid_t mPid = -1;
-  int mFd = -1;
-};
-
-Result<RawResult> runTetGenGuarded(const TriangleMesh& surface, const std::string& switches, double timeout) {
-  thread_local TetGenWorker worker;
-  return worker.run(surface, switches, timeout);
-}
-
-/// TetGen's error codes (terminatetetgen in tetgen.cxx).
-std::string describeTetGenError(int code) {
-  switch (code) {
-    case 1:
-      return "TetGen ran out of memory";
-    case 2:
-      return "TetGen hit an internal error";
-    case 3:
-      return "TetGen found self-intersecting faces in the surface";
-    case 4:
-      return "TetGen found a very small input feature it cannot resolve";
-    case 5:
-      return "TetGen found two very close input faces";
-    case 10:
-      return "TetGen found an input error";
-    default:
-      return "TetGen failed (code " + std::to_string(code) + ")";
-  }
-}
-
-}  // namespace
 
 std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, bool mergeFacets) {
   // p: the input is a piecewise linear complex; q: quality bound; a: volume bound; M: no merging of
@@ -299,15 +42,15 @@ Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const Tetrahedra
                                    const core::MassProperties& mass, bool mergeFacets) {
   const double volume = mass.volume;
   const std::string switches = tetgenSwitches(options, volume, mergeFacets);
-  RawResult raw;
+  detail::TetGenOutput raw;
   if (options.guarded) {
-    auto guarded = runTetGenGuarded(surface, switches, options.timeoutSeconds);
+    auto guarded = detail::runTetGenGuarded(surface, switches, options.timeoutSeconds);
     if (!guarded) return guarded.error();
     raw = std::move(guarded).value();
   } else {
-    raw = runTetGen(surface, switches);
+    raw = detail::runTetGen(surface, switches);
   }
-  if (raw.status != 0) return Error{ErrorCode::kParse, describeTetGenError(raw.status)};
+  if (raw.status != 0) return Error{ErrorCode::kParse, detail::describeTetGenError(raw.status)};
 
   TetMesh mesh;
   mesh.nodes.resize(raw.nodes.size() / 3);
@@ -409,11 +152,5 @@ void dropFlatTets(TetMesh& mesh) {
     for (std::uint32_t& v : t)
       v = static_cast<std::uint32_t>(renumber[v]);
 }
-
-namespace testing {
-void killNextTetGenWorkers(int count) {
-  gWorkersToKill.store(std::max(count, 0));
-}
-}  // namespace testing
 
 }  // namespace shapedb::volume
