@@ -16,57 +16,11 @@
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
 #include <shapedb/core/triangle_mesh.h>
+#include <shapedb/io/build.h>
 #include <shapedb/io/store.h>
 #include <shapedb/volume/correction.h>
 
 namespace shapedb::io {
-
-/// Where a build stands, for progress displays. Reported after each entry is computed.
-struct BuildProgress {
-  std::size_t done = 0;     ///< entries finished in this run (built or failed)
-  std::size_t total = 0;    ///< entries this run has to do
-  std::size_t failed = 0;   ///< of `done`
-  std::size_t skipped = 0;  ///< already in the file when the run started (resume)
-  double elapsedSeconds = 0.0;
-  std::string lastName;
-};
-
-struct BuildOptions {
-  BuildParameters parameters;  ///< for a new file; a resumed build uses the file's own
-  int threads = 0;             ///< 0: all cores
-  std::size_t batchSize = 16;  ///< entries per transaction: what a crash can cost
-  /// Continue the build in an existing file: entries already in it (or recorded as failed) are skipped.
-  bool resume = false;
-  std::function<void(const BuildProgress&)> progress;  ///< called from one thread at a time
-};
-
-/// What a build run did.
-struct BuildReport {
-  std::size_t built = 0, failed = 0, skipped = 0;
-  double seconds = 0.0;             ///< wall time of this run
-  volume::StageTimes stageSeconds;  ///< summed over the entries built (CPU-seconds per stage)
-};
-
-/// Builds (or, with resume, continues building) the database file at `path`: the catalog of the
-/// parameters' families, each entry computed by volume::computeEntry in parallel (TBB) and committed in
-/// order, batch by batch. A killed build loses at most the batches not yet committed; resuming redoes
-/// them and nothing else, so a resumed build holds exactly what a clean one does. An entry that fails (a
-/// shape TetGen refuses, say) is recorded with its reason and the build goes on.
-/// Errors: kIo (file exists without resume, or missing with resume; disk), kInvalidArgument (parameters).
-Result<BuildReport> buildDatabase(const std::filesystem::path& path, const BuildOptions& options);
-
-/// A user mesh to add: its surface and the name it goes by (the file's name, by default).
-struct NamedMesh {
-  std::string name;
-  std::string source;
-  core::TriangleMesh mesh;
-};
-
-/// Adds meshes to an existing database as `user` entries, computed with the file's parameters and
-/// written in one transaction: all or none. Returns their ids. TetGen runs guarded (these meshes come
-/// from outside). Errors: the first mesh that fails, named; kInvalidArgument for a name already present.
-Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& path,
-                                                 std::span<const NamedMesh> meshes);
 
 /// What Database::query does beyond matching.
 struct QueryOptions {
