@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
-
-#include <tbb/parallel_for.h>
+#include <functional>
 
 namespace shapedb::core {
 
@@ -24,15 +23,8 @@ struct Chunks {
     return chunk + 1 == count ? items : (chunk + 1) * (items / count);
   }
 
-  /// Runs f(chunk, begin, end) for every chunk, in parallel when there are several.
-  template <typename F>
-  void run(F&& f) const {
-    if (count == 1) {
-      f(std::size_t{0}, std::size_t{0}, items);
-      return;
-    }
-    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t c) { f(c, begin(c), end(c)); });
-  }
+  /// Runs f(chunk, begin, end) for every chunk, in parallel (TBB) when there are several.
+  void run(const std::function<void(std::size_t, std::size_t, std::size_t)>& f) const;
 
   /// The sum over the chunks of partial(begin, end), each computed as run() does and added in chunk
   /// order. T: copyable, with +=.
