@@ -24,10 +24,52 @@ std::mutex* blasLock() {
   return lock;
 }
 
-std::unique_lock<std::mutex> lockBlas() {
-  std::mutex* lock = blasLock();
-  return lock ? std::unique_lock<std::mutex>(*lock) : std::unique_lock<std::mutex>();
-}
+/// Debian's CHOLMOD runs parts of a large factorization in OpenMP parallel regions of up to four threads.
+/// Its callers already run one factorization per core (a build's workers), so those threads only fight
+/// them: a 2-thread build of 112 entries took 29.0 s with them and 26.1 s without. OpenMP's
+/// max-active-levels is a per-thread setting; 0 runs this thread's parallel regions on this thread
+/// alone, and the previous value comes back when the call is over. Found at run time, as the OpenMP
+/// runtime CHOLMOD was built with (none: nothing to do).
+class SerialOpenMp {
+ public:
+  SerialOpenMp() {
+    if (functions().set) {
+      mPrevious = functions().get();
+      functions().set(0);
+    }
+  }
+  ~SerialOpenMp() {
+    if (functions().set) functions().set(mPrevious);
+  }
+  SerialOpenMp(const SerialOpenMp&) = delete;
+  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+ private:
+  struct Functions {
+    int (*get)() = nullptr;
+    void (*set)(int) = nullptr;
+  };
+  static const Functions& functions() {
+    static const Functions f = [] {
+      Functions found;
+      found.get = reinterpret_cast<int (*)()>(::dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+      found.set = reinterpret_cast<void (*)(int)>(::dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+      if (!found.get || !found.set) found = {};
+      return found;
+    }();
+    return f;
+  }
+  int mPrevious = 1;
+};
+
+/// What every call into CHOLMOD holds: the BLAS lock where one is needed, and OpenMP kept to this thread.
+struct CallGuard {
+  std::unique_lock<std::mutex> blas = [] {
+    std::mutex* lock = blasLock();
+    return lock ? std::unique_lock<std::mutex>(*lock) : std::unique_lock<std::mutex>();
+  }();
+  SerialOpenMp openMp;
+};
 
 }  // namespace
 
@@ -84,7 +126,7 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   s.common.nmethods = 1;
   s.common.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
   s.common.postorder = 1;
-  const std::unique_lock<std::mutex> lock = lockBlas();
+  const CallGuard guard;
   s.factor =
       cholmod_analyze_p(&a, order.empty() ? nullptr : const_cast<int*>(order.data()), nullptr, 0, &s.common);
   if (!s.factor) return false;
@@ -107,7 +149,7 @@ bool SparseCholesky::solve(const double* b, double* x, Eigen::Index columns) con
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   auto& common = const_cast<cholmod_common&>(s.common);
-  const std::unique_lock<std::mutex> lock = lockBlas();
+  const CallGuard guard;
   if (!s.factor || !cholmod_solve2(CHOLMOD_A, s.factor, &rhs, nullptr, &s.x, nullptr, &s.y, &s.e, &common)) {
     std::fill(x, x + rhs.nzmax, std::numeric_limits<double>::quiet_NaN());
     return false;
