@@ -3,12 +3,14 @@
 // Subcommands of the shapedb executable. Each is thin: it parses, calls the library, and prints.
 
 #include <functional>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 
 #include <shapedb/core/result.h>
 #include <shapedb/io/mesh_io.h>
 #include <shapedb/volume/fracture.h>
+#include <shapedb/volume/repair.h>
 
 namespace shapedb::cli {
 
@@ -42,7 +44,9 @@ Command addDropCommand(CLI::App& parent);
 /// --weld-tolerance), on every command that reads meshes.
 struct MeshLoadFlags {
   io::LoadOptions options;
-  std::string units;  ///< as given ("" when neither --units nor --scale was)
+  std::string units;    ///< as given ("" when neither --units nor --scale was)
+  bool repair = false;  ///< --repair: volume::repairSurface after loading
+  volume::RepairOptions repairOptions;
 };
 
 /// Loads a mesh file and fractures it; errors name the file. Shared by fracture and haptic --fracture.
@@ -57,12 +61,15 @@ void printError(const std::string& message);
 /// The flag that would get past a refusal of a mesh, as "; --flag ..." to append to its message, or "".
 std::string flagHint(const Error& error);
 
-/// Adds --units, --scale and --weld-tolerance to `app`.
+/// Adds --units, --scale, --weld-tolerance, --repair and --repair-resolution to `app`.
 void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags);
 
 /// io::loadMesh, and what it did to the file's mesh (a surface wound inward and flipped, vertices
 /// welded) printed on stderr as "shapedb: warning: <file>: <note>"; so is a size that suggests another
-/// unit than metres, when none was given. Every command that reads a mesh file reads it through this.
-Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags = {});
+/// unit than metres, when none was given. With flags.repair, the mesh is then repaired
+/// (volume::repairSurface), what the repair did printed as a note, and given in `repaired` when asked.
+/// Every command that reads a mesh file reads it through this.
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags = {},
+                                    std::optional<volume::RepairReport>* repaired = nullptr);
 
 }  // namespace shapedb::cli

@@ -8,7 +8,8 @@ namespace shapedb::cli {
 
 std::string flagHint(const Error& error) {
   if (error.code == ErrorCode::kNotClosed || error.code == ErrorCode::kNonManifold)
-    return "; if its vertices only nearly coincide, --weld-tolerance F (say 1e-6) welds them";
+    return "; if its vertices only nearly coincide, --weld-tolerance F (say 1e-6) welds them; --repair "
+           "closes small holes and remeshes a non-manifold surface";
   return "";
 }
 
@@ -32,6 +33,14 @@ void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
          "Multiply the mesh files' coordinates by this to get metres")
       ->check(CLI::PositiveNumber)
       ->excludes(units);
+  app.add_flag(
+      "--repair", flags.repair,
+      "Make a closed surface of an open, non-manifold or self-intersecting one: holes up to a tenth\n"
+      "of the mesh across are shut, the rest stays within a voxel (a level set; prints what changed)");
+  app.add_option("--repair-resolution", flags.repairOptions.resolution,
+                 "With --repair: voxels along the mesh's largest side")
+      ->capture_default_str()
+      ->check(CLI::Range(16, 1024));
   app.add_option("--weld-tolerance", flags.options.weldTolerance,
                  "An open surface's vertices closer than this fraction of its bounding box's diagonal are\n"
                  "welded into one (exactly coincident ones always are)")
@@ -39,11 +48,32 @@ void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
       ->check(CLI::Range(0.0, 0.01));
 }
 
-Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags) {
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags,
+                                    std::optional<volume::RepairReport>* repaired) {
   Result<io::LoadedMesh> loaded = io::loadMesh(path, flags.options);
   if (!loaded) return loaded;
   for (const std::string& note : loaded->notes())
     std::fprintf(stderr, "shapedb: warning: %s: %s\n", path.c_str(), note.c_str());
+  if (flags.repair) {
+    Result<volume::RepairedSurface> repair = volume::repairSurface(loaded->mesh, flags.repairOptions);
+    if (!repair) return withContext(repair.error(), path + ": --repair");
+    const volume::RepairReport& r = repair->report;
+    char volume[96];
+    if (r.volumeBefore)
+      std::snprintf(volume, sizeof volume, "volume %.4g -> %.4g (%+.2f %%)", *r.volumeBefore, r.volumeAfter,
+                    100.0 * (r.volumeAfter / *r.volumeBefore - 1.0));
+    else
+      std::snprintf(volume, sizeof volume, "volume %.4g (none before: not closed)", r.volumeAfter);
+    std::fprintf(
+        stderr,
+        "shapedb: note: %s: repaired at %d voxels (%.3g each): %zu holes shut (closing radius %.3g), "
+        "%s, area %.4g -> %.4g, %zu -> %zu triangles\n",
+        path.c_str(), r.resolution, r.voxelSize, r.holes, r.closingRadius, volume, r.areaBefore, r.areaAfter,
+        r.trianglesBefore, r.trianglesAfter);
+    loaded->mesh = std::move(repair->mesh);
+    loaded->topology = core::analyzeTopology(loaded->mesh);
+    if (repaired) *repaired = r;
+  }
   if (flags.units.empty() && !loaded->mesh.vertices.empty()) {
     const core::Bounds bounds = core::computeBounds(loaded->mesh);
     const double size = (bounds.max - bounds.min).maxCoeff();

@@ -273,9 +273,10 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   if (o.table && !o.json) printTableHeader();
   for (std::size_t i = 0; i < o.meshes.size(); ++i) {
     const std::string& file = o.meshes[i];
-    auto loaded = loadMeshFile(file, o.load);
+    std::optional<volume::RepairReport> repaired;
+    auto loaded = loadMeshFile(file, o.load, &repaired);
     if (!loaded) {
-      printError(loaded.error().message);
+      printError(loaded.error().message + flagHint(loaded.error()));
       status = kExitInputError;
       continue;
     }
@@ -306,6 +307,16 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
                           {"descriptor", o.descriptor},
                           {"matches", nlohmann::json::array()},
                           {"timing_us", timingJson(result->times)}};
+      if (repaired)
+        q["repaired"] = {{"resolution", repaired->resolution},
+                         {"voxel_size", repaired->voxelSize},
+                         {"holes", repaired->holes},
+                         {"closing_radius", repaired->closingRadius},
+                         {"volume_before", repaired->volumeBefore ? nlohmann::json(*repaired->volumeBefore)
+                                                                  : nlohmann::json(nullptr)},
+                         {"volume_after", repaired->volumeAfter},
+                         {"area_before", repaired->areaBefore},
+                         {"area_after", repaired->areaAfter}};
       for (const io::MatchReport& m : result->matches)
         q["matches"].push_back(matchJson(m));
       if (!result->matches.empty() && result->matches.front().fidelity)

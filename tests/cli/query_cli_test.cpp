@@ -145,6 +145,52 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   EXPECT_NE(text.out.find("timing (µs)"), std::string::npos) << text.out;
 }
 
+// A closed mesh with holes punched in it is refused, with the flag that gets past it; with --repair it is
+// answered as the closed mesh is: the same match, mass and first frequency within 2 %.
+TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
+  test::ScratchDir dir("query-cli-repair");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "4", "--families",
+                                           "ellipsoid,box", "--modes", "4", "--quiet"})
+                .exitCode,
+            0);
+  const core::TriangleMesh closed = core::makeUvEllipsoid({0.12, 0.08, 0.05}, 96, 48);
+  core::TriangleMesh holed;
+  holed.vertices = closed.vertices;
+  for (const auto& t : closed.triangles) {
+    const core::Vec3 c = (closed.vertices[t[0]] + closed.vertices[t[1]] + closed.vertices[t[2]]) / 3.0;
+    if ((c - core::Vec3(0.12, 0, 0)).norm() > 0.005 && (c - core::Vec3(0, 0.08, 0)).norm() > 0.005)
+      holed.triangles.push_back(t);
+  }
+  const auto closedPath = dir / "closed.obj", holedPath = dir / "holed.obj";
+  ASSERT_TRUE(io::saveMesh(closed, closedPath).ok());
+  ASSERT_TRUE(io::saveMesh(holed, holedPath).ok());
+
+  test::ProcessResult refused = test::runProcess(SHAPEDB_CLI, {"query", db.string(), holedPath.string()});
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(refused.err.find("--repair"), std::string::npos) << refused.err;
+
+  const auto answer = [&](const std::filesystem::path& mesh, bool repair) {
+    std::vector<std::string> args = {"query", db.string(), mesh.string(), "--json", "--no-fidelity"};
+    if (repair) args.push_back("--repair");
+    test::ProcessResult q = test::runProcess(SHAPEDB_CLI, args);
+    EXPECT_EQ(q.exitCode, 0) << q.err;
+    return q.exitCode == 0 ? nlohmann::json::parse(q.out)["queries"][0] : nlohmann::json();
+  };
+  const nlohmann::json original = answer(closedPath, false), repaired = answer(holedPath, true);
+  ASSERT_FALSE(original.is_null());
+  ASSERT_FALSE(repaired.is_null());
+  ASSERT_TRUE(repaired.contains("repaired"));
+  EXPECT_EQ(repaired["repaired"]["holes"], 2);
+  EXPECT_TRUE(repaired["repaired"]["volume_before"].is_null());
+  EXPECT_EQ(repaired["matches"][0]["name"], original["matches"][0]["name"]);
+  EXPECT_NEAR(repaired["physics"]["mass"].get<double>() / original["physics"]["mass"].get<double>(), 1.0,
+              0.02);
+  EXPECT_NEAR(repaired["physics"]["frequencies_hz"][0].get<double>() /
+                  original["physics"]["frequencies_hz"][0].get<double>(),
+              1.0, 0.02);
+}
+
 TEST(QueryCli, BadInputsAreClearErrors) {
   test::ScratchDir dir("query-cli-bad");
   const auto db = dir / "small.db";

@@ -1,10 +1,22 @@
 #include "level_set.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+
+#include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
+#include <shapedb/volume/repair.h>
 #include <shapedb/volume/simplify.h>
 
 namespace shapedb::volume::detail {
@@ -111,3 +123,200 @@ std::pair<TriangleMesh, Meshing> closedSurface(const openvdb::FloatGrid& grid, d
 }
 
 }  // namespace shapedb::volume::detail
+
+namespace shapedb::volume {
+namespace {
+
+using core::TriangleMesh;
+using core::Vec3;
+
+/// The open boundary's loops: edges of one triangle, grouped by the vertices they share. For each, the
+/// largest distance of its vertices from their centroid: about half the hole's width.
+std::vector<double> holeRadii(const TriangleMesh& mesh) {
+  std::unordered_map<std::uint64_t, int> edgeUses;
+  const auto key = [](std::uint32_t a, std::uint32_t b) {
+    return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+  };
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      ++edgeUses[key(t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>((k + 1) % 3)])];
+  std::vector<std::uint32_t> parent(mesh.vertices.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  const auto find = [&](std::uint32_t v) {
+    while (parent[v] != v)
+      v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  std::vector<bool> onBoundary(mesh.vertices.size(), false);
+  for (const auto& [edge, uses] : edgeUses) {
+    if (uses != 1) continue;
+    const auto a = static_cast<std::uint32_t>(edge >> 32), b = static_cast<std::uint32_t>(edge & 0xffffffffu);
+    onBoundary[a] = onBoundary[b] = true;
+    parent[find(a)] = find(b);
+  }
+  std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> loops;
+  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
+    if (onBoundary[v]) loops[find(v)].push_back(v);
+  std::vector<double> radii;
+  for (const auto& [root, vertices] : loops) {
+    Vec3 centre = Vec3::Zero();
+    for (std::uint32_t v : vertices)
+      centre += mesh.vertices[v];
+    centre /= static_cast<double>(vertices.size());
+    double radius = 0.0;
+    for (std::uint32_t v : vertices)
+      radius = std::max(radius, (mesh.vertices[v] - centre).norm());
+    radii.push_back(radius);
+  }
+  std::sort(radii.begin(), radii.end());
+  return radii;
+}
+
+}  // namespace
+
+Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOptions& options) {
+  if (options.resolution < 16 || options.resolution > 1024)
+    return Error{ErrorCode::kInvalidArgument, "the repair's resolution must be 16 to 1024 voxels"};
+  if (!(options.maxHoleFraction > 0.0 && options.maxHoleFraction <= 0.5))
+    return Error{ErrorCode::kInvalidArgument, "the largest hole to close must be a fraction in (0, 0.5]"};
+  if (mesh.triangles.empty() || mesh.vertices.empty())
+    return Error{ErrorCode::kEmptyMesh, "the mesh has no triangles"};
+  for (const Vec3& p : mesh.vertices)
+    if (!p.allFinite()) return Error{ErrorCode::kNonFinite, "the mesh has a vertex that is not finite"};
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t)
+      if (v >= mesh.vertices.size())
+        return Error{ErrorCode::kIndexOutOfRange, "a triangle refers to a vertex that does not exist"};
+
+  RepairReport report;
+  report.resolution = options.resolution;
+  report.trianglesBefore = mesh.triangles.size();
+  report.areaBefore = core::computeSurfaceArea(mesh);
+  if (detail::isClosedSolid(mesh)) report.volumeBefore = core::computeSignedVolume(mesh);
+  const core::Bounds bounds = core::computeBounds(mesh);
+  const double extent = (bounds.max - bounds.min).maxCoeff();
+  if (!(extent > 0.0)) return Error{ErrorCode::kEmptyMesh, "the mesh has no extent"};
+  const double voxel = extent / options.resolution;
+  report.voxelSize = voxel;
+
+  // The closing radius: wide enough to shut the widest hole.
+  const std::vector<double> holes = holeRadii(mesh);
+  report.holes = holes.size();
+  const double widest = holes.empty() ? 0.0 : holes.back();
+  if (2.0 * widest > options.maxHoleFraction * extent) {
+    char message[200];
+    std::snprintf(message, sizeof message,
+                  "a hole %.3g across (%.0f %% of the mesh's largest side) is wider than the repair closes "
+                  "(%.0f %%)",
+                  2.0 * widest, 100.0 * 2.0 * widest / extent, 100.0 * options.maxHoleFraction);
+    return Error{ErrorCode::kInvalidArgument, message};
+  }
+  const double radius = std::max(1.5 * voxel, widest + voxel);
+  report.closingRadius = radius;
+
+  // A local frame (float points near the origin; bounds away from the tree's top-level seams), a band
+  // reaching past the closing radius on both sides.
+  const double bandVoxels = radius / voxel + 4.0;
+  const Vec3 origin = bounds.min - Vec3::Constant((bandVoxels + 16.0) * voxel);
+  TriangleMesh local = mesh;
+  for (Vec3& p : local.vertices)
+    p -= origin;
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(voxel);
+  const detail::OpenVdbMesh vdb = detail::toOpenVdb(local);
+  const openvdb::FloatGrid::Ptr distance = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(
+      *transform, vdb.points, vdb.triangles, std::vector<openvdb::Vec4I>{}, static_cast<float>(bandVoxels));
+
+  // Outside: every voxel at least the radius from the surface that can be reached from the box's faces
+  // through such voxels. The rest (the surface's neighbourhood and what it shuts in) is the closed solid
+  // grown by the radius.
+  const openvdb::Coord lo = transform->worldToIndexCellCentered(openvdb::Vec3d(0.0, 0.0, 0.0));
+  const Vec3 top = bounds.max - origin + Vec3::Constant((bandVoxels + 16.0) * voxel);
+  const openvdb::Coord hi = transform->worldToIndexCellCentered(openvdb::Vec3d(top.x(), top.y(), top.z()));
+  const openvdb::Coord dims = hi - lo + openvdb::Coord(1, 1, 1);
+  const auto nx = static_cast<std::size_t>(dims.x()), ny = static_cast<std::size_t>(dims.y()),
+             nz = static_cast<std::size_t>(dims.z());
+  const auto index = [&](std::size_t x, std::size_t y, std::size_t z) { return (x * ny + y) * nz + z; };
+  const float r = static_cast<float>(radius);
+  std::vector<std::uint8_t> outside(nx * ny * nz, 0);
+  {
+    openvdb::FloatGrid::ConstAccessor d = distance->getConstAccessor();
+    const auto open = [&](std::size_t x, std::size_t y, std::size_t z) {
+      return d.getValue(lo + openvdb::Coord(static_cast<int>(x), static_cast<int>(y), static_cast<int>(z))) >=
+             r;
+    };
+    std::vector<std::size_t> queue;
+    const auto visit = [&](std::size_t x, std::size_t y, std::size_t z) {
+      const std::size_t i = index(x, y, z);
+      if (outside[i] || !open(x, y, z)) return;
+      outside[i] = 1;
+      queue.push_back(i);
+    };
+    for (std::size_t x = 0; x < nx; ++x)
+      for (std::size_t y = 0; y < ny; ++y) {
+        visit(x, y, 0);
+        visit(x, y, nz - 1);
+      }
+    for (std::size_t x = 0; x < nx; ++x)
+      for (std::size_t z = 0; z < nz; ++z) {
+        visit(x, 0, z);
+        visit(x, ny - 1, z);
+      }
+    for (std::size_t y = 0; y < ny; ++y)
+      for (std::size_t z = 0; z < nz; ++z) {
+        visit(0, y, z);
+        visit(nx - 1, y, z);
+      }
+    while (!queue.empty()) {
+      const std::size_t i = queue.back();
+      queue.pop_back();
+      const std::size_t z = i % nz, y = (i / nz) % ny, x = i / (ny * nz);
+      if (x > 0) visit(x - 1, y, z);
+      if (x + 1 < nx) visit(x + 1, y, z);
+      if (y > 0) visit(x, y - 1, z);
+      if (y + 1 < ny) visit(x, y + 1, z);
+      if (z > 0) visit(x, y, z - 1);
+      if (z + 1 < nz) visit(x, y, z + 1);
+    }
+  }
+
+  // On the band, a field whose zero crossing is the grown solid's boundary, to sub-voxel accuracy: r − d
+  // (positive within the radius, negative outside it), and positive wherever the surface shuts a voxel
+  // in. Between an outside voxel and its inside neighbour d crosses r, so the crossing is where the
+  // distance is the radius. Then the signed distance to that boundary, and the boundary moved back in by
+  // the radius: the crossing of (distance + r).
+  const openvdb::FloatGrid::Ptr grown = distance->deepCopy();
+  for (openvdb::FloatGrid::ValueOnIter it = grown->beginValueOn(); it; ++it) {
+    const openvdb::Coord c = it.getCoord() - lo;
+    const bool out = c.x() >= 0 && c.y() >= 0 && c.z() >= 0 && static_cast<std::size_t>(c.x()) < nx &&
+                     static_cast<std::size_t>(c.y()) < ny && static_cast<std::size_t>(c.z()) < nz &&
+                     outside[index(static_cast<std::size_t>(c.x()), static_cast<std::size_t>(c.y()),
+                                   static_cast<std::size_t>(c.z()))];
+    const float inside = r - *it;
+    it.setValue(out ? std::min(inside, 0.0f) : std::max(inside, 0.5f * static_cast<float>(voxel)));
+  }
+  outside = {};
+  openvdb::FloatGrid::Ptr solid = openvdb::tools::fogToSdf(*grown, 0.0f);
+  if (!solid) return Error{ErrorCode::kParse, "the repair's level set could not be built"};
+  for (openvdb::FloatGrid::ValueOnIter it = solid->beginValueOn(); it; ++it)
+    if (std::isfinite(*it)) it.setValue(*it + r);
+  // Beyond the band, the sign of its nearest values: outside or inside at the band's distance.
+  openvdb::tools::signedFloodFillWithValues(solid->tree(), static_cast<float>(bandVoxels * voxel),
+                                            -static_cast<float>(bandVoxels * voxel));
+  solid->setTransform(transform);
+
+  auto [surface, meshing] = detail::closedSurface(
+      *solid, voxel, detail::SurfaceOptions{.maxTriangles = options.maxTriangles, .simplifyError = 0.25});
+  if (surface.triangles.empty() || meshing == detail::Meshing::kOpen)
+    return Error{ErrorCode::kParse,
+                 "no closed surface came out of the repair: the mesh encloses nothing that its holes "
+                 "leave shut (a single sheet, or holes wider than " +
+                     std::to_string(2.0 * radius) + " across)"};
+  for (Vec3& p : surface.vertices)
+    p += origin;
+  report.volumeAfter = core::computeSignedVolume(surface);
+  report.areaAfter = core::computeSurfaceArea(surface);
+  report.trianglesAfter = surface.triangles.size();
+  return RepairedSurface{std::move(surface), report};
+}
+
+}  // namespace shapedb::volume
