@@ -6,7 +6,6 @@
 #include <vector>
 
 #include <Eigen/Dense>
-#include <Eigen/OrderingMethods>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
@@ -20,30 +19,6 @@ namespace {
 using core::ModalData;
 using core::TetMesh;
 using SparseMatrix = Eigen::SparseMatrix<double>;
-
-/// A fill-reducing ordering for matrices of 3 × 3 blocks (a node's x, y, z): approximate minimum degree
-/// on the graph of the nodes, each node's three rows kept together; order[k] is the row eliminated k-th.
-/// The same fill as AMD on the scalar graph here, in a fraction of the analysis time (the node graph has a
-/// ninth of the entries).
-std::vector<int> nodeBlockOrder(const SparseMatrix& matrix) {
-  const Eigen::Index nodes = matrix.rows() / 3;
-  std::vector<Eigen::Triplet<double, int>> pattern;
-  pattern.reserve(static_cast<std::size_t>(matrix.nonZeros() / 9 + nodes));
-  for (Eigen::Index column = 0; column < matrix.outerSize(); column += 3)
-    for (SparseMatrix::InnerIterator it(matrix, column); it; ++it)
-      if (it.row() % 3 == 0)
-        pattern.emplace_back(static_cast<int>(it.row() / 3), static_cast<int>(column / 3), 1.0);
-  SparseMatrix graph(nodes, nodes);
-  graph.setFromTriplets(pattern.begin(), pattern.end());
-  // Eigen's orderings return the inverse permutation: its k-th index is the node eliminated k-th.
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> nodeOrder;
-  Eigen::AMDOrdering<int>()(graph, nodeOrder);
-  std::vector<int> order(static_cast<std::size_t>(3 * nodes));
-  for (Eigen::Index i = 0; i < nodes; ++i)
-    for (int c = 0; c < 3; ++c)
-      order[static_cast<std::size_t>(3 * i + c)] = 3 * nodeOrder.indices()[i] + c;
-  return order;
-}
 
 /// y = P (K − σM)⁻¹ x for Spectra's shift-invert mode, by a supernodal sparse Cholesky factorization of
 /// K − σM (symmetric positive definite for σ < 0: K is semi-definite and M definite; Spectra's own
@@ -60,7 +35,7 @@ class ShiftInvertLdlt {
   void set_shift(double sigma) {  // NOLINT: Spectra's interface
     SparseMatrix shifted = mK - sigma * mM;
     shifted.makeCompressed();
-    mOk = mSolver.factorize(shifted, nodeBlockOrder(shifted));
+    mOk = mSolver.factorize(shifted, detail::nodeBlockOrder(shifted));
   }
   void perform_op(const double* in, double* out) const {  // NOLINT: Spectra's interface
     mSolver.solve(in, out);                               // NaN if it failed: Lanczos then fails, and says so

@@ -7,6 +7,8 @@
 #include <limits>
 #include <mutex>
 
+#include <Eigen/OrderingMethods>
+
 namespace shapedb::volume::detail {
 namespace {
 
@@ -72,6 +74,26 @@ struct CallGuard {
 };
 
 }  // namespace
+
+std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix) {
+  const Eigen::Index nodes = matrix.rows() / 3;
+  std::vector<Eigen::Triplet<double, int>> pattern;
+  pattern.reserve(static_cast<std::size_t>(matrix.nonZeros() / 9 + nodes));
+  for (Eigen::Index column = 0; column < matrix.outerSize(); column += 3)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix, column); it; ++it)
+      if (it.row() % 3 == 0)
+        pattern.emplace_back(static_cast<int>(it.row() / 3), static_cast<int>(column / 3), 1.0);
+  Eigen::SparseMatrix<double> graph(nodes, nodes);
+  graph.setFromTriplets(pattern.begin(), pattern.end());
+  // Eigen's orderings return the inverse permutation: its k-th index is the node eliminated k-th.
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> nodeOrder;
+  Eigen::AMDOrdering<int>()(graph, nodeOrder);
+  std::vector<int> order(static_cast<std::size_t>(3 * nodes));
+  for (Eigen::Index i = 0; i < nodes; ++i)
+    for (int c = 0; c < 3; ++c)
+      order[static_cast<std::size_t>(3 * i + c)] = 3 * nodeOrder.indices()[i] + c;
+  return order;
+}
 
 /// CHOLMOD's state: its workspace (`common`), the factor, and the dense buffers cholmod_solve2 reuses from
 /// one solve to the next (mutable: a solve changes no result, only scratch space).

@@ -13,6 +13,12 @@
 
 namespace shapedb::volume::detail {
 
+/// A fill-reducing order for matrices of 3 × 3 blocks (a node's x, y, z, as FEM matrices are):
+/// approximate minimum degree on the graph of the nodes, each node's three rows kept together; order[k] is
+/// the row eliminated k-th. The same fill as AMD on the scalar graph, in a fraction of the analysis time
+/// (the node graph has a ninth of the entries). Precondition: rows() divisible by 3.
+std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix);
+
 class SparseCholesky {
  public:
   SparseCholesky();
