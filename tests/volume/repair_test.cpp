@@ -112,6 +112,14 @@ TEST(Repair, ACoarseRepairOfAnEllipsoidWithHolesIsClosed) {
   EXPECT_TRUE(closedAndOriented(repaired->mesh));
   EXPECT_EQ(repaired->report.holes, 2u);
   EXPECT_NEAR(repaired->report.volumeAfter / core::computeSignedVolume(solid), 1.0, 0.05);
+  // The same a millionth the size (a part in metres read as millimetres): the same answer, to scale.
+  core::Mat4 shrink = core::Mat4::Identity();
+  shrink.topLeftCorner<3, 3>() *= 1e-6;
+  Result<RepairedSurface> tiny =
+      repairSurface(core::transformed(open, shrink), {.resolution = 40, .maxHoleFraction = 0.3});
+  ASSERT_TRUE(tiny.ok()) << tiny.error().message;
+  EXPECT_TRUE(closedAndOriented(tiny->mesh));
+  EXPECT_NEAR(tiny->report.volumeAfter / (1e-18 * repaired->report.volumeAfter), 1.0, 1e-3);
 }
 
 TEST(Repair, WhatCannotBeClosedIsAnErrorThatSaysWhy) {

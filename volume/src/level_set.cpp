@@ -214,14 +214,17 @@ Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOpti
   const double radius = std::max(1.5 * voxel, widest + voxel);
   report.closingRadius = radius;
 
-  // A local frame (float points near the origin; bounds away from the tree's top-level seams), a band
-  // reaching past the closing radius on both sides.
+  // A local frame: float points near the origin, bounds away from the tree's top-level seams, and the
+  // largest side 1 (OpenVDB refuses very small voxels: a 10 cm part read with --units mm, 0.1 mm across,
+  // threw "Non-zero scale values required"), with a band reaching past the closing radius on both sides.
+  // h and rr are the voxel and the radius there.
+  const double h = voxel / extent, rr = radius / extent;
   const double bandVoxels = radius / voxel + 4.0;
   const Vec3 origin = bounds.min - Vec3::Constant((bandVoxels + 16.0) * voxel);
   TriangleMesh local = mesh;
   for (Vec3& p : local.vertices)
-    p -= origin;
-  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(voxel);
+    p = (p - origin) / extent;
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(h);
   const detail::OpenVdbMesh vdb = detail::toOpenVdb(local);
   const openvdb::FloatGrid::Ptr distance = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(
       *transform, vdb.points, vdb.triangles, std::vector<openvdb::Vec4I>{}, static_cast<float>(bandVoxels));
@@ -230,13 +233,13 @@ Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOpti
   // through such voxels. The rest (the surface's neighbourhood and what it shuts in) is the closed solid
   // grown by the radius.
   const openvdb::Coord lo = transform->worldToIndexCellCentered(openvdb::Vec3d(0.0, 0.0, 0.0));
-  const Vec3 top = bounds.max - origin + Vec3::Constant((bandVoxels + 16.0) * voxel);
+  const Vec3 top = (bounds.max - origin) / extent + Vec3::Constant((bandVoxels + 16.0) * h);
   const openvdb::Coord hi = transform->worldToIndexCellCentered(openvdb::Vec3d(top.x(), top.y(), top.z()));
   const openvdb::Coord dims = hi - lo + openvdb::Coord(1, 1, 1);
   const auto nx = static_cast<std::size_t>(dims.x()), ny = static_cast<std::size_t>(dims.y()),
              nz = static_cast<std::size_t>(dims.z());
   const auto index = [&](std::size_t x, std::size_t y, std::size_t z) { return (x * ny + y) * nz + z; };
-  const float r = static_cast<float>(radius);
+  const float r = static_cast<float>(rr);
   std::vector<std::uint8_t> outside(nx * ny * nz, 0);
   {
     openvdb::FloatGrid::ConstAccessor d = distance->getConstAccessor();
@@ -292,7 +295,7 @@ Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOpti
                      outside[index(static_cast<std::size_t>(c.x()), static_cast<std::size_t>(c.y()),
                                    static_cast<std::size_t>(c.z()))];
     const float inside = r - *it;
-    it.setValue(out ? std::min(inside, 0.0f) : std::max(inside, 0.5f * static_cast<float>(voxel)));
+    it.setValue(out ? std::min(inside, 0.0f) : std::max(inside, 0.5f * static_cast<float>(h)));
   }
   outside = {};
   openvdb::FloatGrid::Ptr solid = openvdb::tools::fogToSdf(*grown, 0.0f);
@@ -300,19 +303,19 @@ Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOpti
   for (openvdb::FloatGrid::ValueOnIter it = solid->beginValueOn(); it; ++it)
     if (std::isfinite(*it)) it.setValue(*it + r);
   // Beyond the band, the sign of its nearest values: outside or inside at the band's distance.
-  openvdb::tools::signedFloodFillWithValues(solid->tree(), static_cast<float>(bandVoxels * voxel),
-                                            -static_cast<float>(bandVoxels * voxel));
+  openvdb::tools::signedFloodFillWithValues(solid->tree(), static_cast<float>(bandVoxels * h),
+                                            -static_cast<float>(bandVoxels * h));
   solid->setTransform(transform);
 
   auto [surface, meshing] = detail::closedSurface(
-      *solid, voxel, detail::SurfaceOptions{.maxTriangles = options.maxTriangles, .simplifyError = 0.25});
+      *solid, h, detail::SurfaceOptions{.maxTriangles = options.maxTriangles, .simplifyError = 0.25});
   if (surface.triangles.empty() || meshing == detail::Meshing::kOpen)
     return Error{ErrorCode::kParse,
                  "no closed surface came out of the repair: the mesh encloses nothing that its holes "
                  "leave shut (a single sheet, or holes wider than " +
                      std::to_string(2.0 * radius) + " across)"};
   for (Vec3& p : surface.vertices)
-    p += origin;
+    p = origin + extent * p;
   report.volumeAfter = core::computeSignedVolume(surface);
   report.areaAfter = core::computeSurfaceArea(surface);
   report.trianglesAfter = surface.triangles.size();
