@@ -298,7 +298,7 @@ Command addDropCommand(CLI::App& parent) {
       "Print one JSON object: {bodies: [{name, mass, shapes, start_center_of_mass, "
       "final_center_of_mass,\nrest_time, lowest_point}], at_rest, deepest_penetration, energy_start, "
       "energy_end, ...}");
-  app->callback([o, app] {
+  app->callback([o] {
     if (o->fractureMesh.empty() == o->meshes.empty())
       throw CLI::ValidationError("give either MESH files or --fracture MESH");
   });

@@ -15,8 +15,8 @@ packages=(
   nlohmann-json3-dev libsqlite3-dev libstb-dev zlib1g-dev sqlite3 libbullet-dev
   libsuitesparse-dev libblis4-serial
 )
-# The fuzz preset builds with Clang and links libFuzzer.
-[ "$preset" = fuzz ] && packages+=(clang-14 libclang-rt-14-dev)
+# The sanitizer presets asan and fuzz build with Clang (fuzz links libFuzzer).
+case "$preset" in asan | fuzz) packages+=(clang-14 libclang-rt-14-dev) ;; esac
 missing=()
 for package in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
