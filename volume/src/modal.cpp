@@ -243,6 +243,10 @@ const Eigen::Matrix<double, 10, 10>& quadraticReferenceMass() {
   return mass;
 }
 
+namespace {
+
+/// The quadrature of degree 2 the quadratic stiffness needs (exact for it): four points, weight V/4
+/// each, at these barycentric coordinates.
 const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints() {
   static const std::array<Eigen::Vector4d, 4> points = [] {
     const double a = 0.5854101966249685, b = 0.1381966011250105;  // (5 ± 3√5) / 20
@@ -251,8 +255,6 @@ const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints() {
   }();
   return points;
 }
-
-namespace {
 
 /// Isotropic elasticity in Voigt order (xx, yy, zz, yz, xz, xy) with engineering shear strains.
 Eigen::Matrix<double, 6, 6> elasticity(const core::Material& material) {

@@ -52,10 +52,6 @@ Eigen::Matrix<double, 3, 10> quadraticGradients(const Eigen::Matrix<double, 3, 4
 /// The reference scalar mass matrix of the 10-node tet: ∫ N_a N_b dV / V, exact.
 const Eigen::Matrix<double, 10, 10>& quadraticReferenceMass();
 
-/// The quadrature of degree 2 the quadratic stiffness needs (exact for it): four points, weight V/4
-/// each, at these barycentric coordinates.
-const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints();
-
 /// K and M of the quadratic tets (stiffness by the exact four-point rule, consistent mass exact).
 FemMatrices assembleFem(const QuadraticTetMesh& mesh, const core::Material& material = core::unitMaterial());
 
