@@ -71,7 +71,7 @@ PrincipalFrame principalFrame(const core::Mat3& inertia) {
 }
 
 Status validate(std::span<const RigidBody> bodies, const DropOptions& o) {
-  const bool optionsOk = std::isfinite(o.lift) && o.lift >= 0.0 && o.seconds > 0.0 && o.seconds <= 3600.0 &&
+  const bool optionsOk = std::isfinite(o.lift) && o.seconds > 0.0 && o.seconds <= 3600.0 &&
                          o.timeStep > 0.0 && o.timeStep <= 0.1 && o.friction >= 0.0 && o.restitution >= 0.0 &&
                          o.restitution <= 1.0 && o.restSpeed > 0.0 && o.restSpin > 0.0 && o.restHold >= 0.0;
   if (!optionsOk) return Error{ErrorCode::kInvalidArgument, "drop options out of range"};
@@ -84,6 +84,12 @@ Status validate(std::span<const RigidBody> bodies, const DropOptions& o) {
         !(principalFrame(b.massProperties.inertia).moments.minCoeff() > 0.0))
       return Error{ErrorCode::kInvalidArgument, which + "inertia must be finite and positive definite"};
     if (b.collision.shapes.empty()) return Error{ErrorCode::kInvalidArgument, which + "no collision shapes"};
+    core::Mat4 lifted = core::Mat4::Identity();
+    lifted(2, 3) = o.lift;
+    for (const core::CollisionShape& shape : b.collision.shapes)
+      if (const double z = lowestPoint(shape, lifted); z < -1e-9)
+        return Error{ErrorCode::kInvalidArgument,
+                     which + "starts below the floor (its lowest point at z = " + std::to_string(z) + " m)"};
   }
   return Ok{};
 }

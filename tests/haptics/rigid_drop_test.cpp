@@ -129,6 +129,20 @@ TEST(RigidDrop, BadBodiesAndOptionsAreErrors) {
   DropOptions options;
   options.timeStep = 0.0;
   EXPECT_EQ(simulateDrop(std::span(&body, 1), options).error().code, ErrorCode::kInvalidArgument);
+
+  // A box centred at the origin reaches z = -0.05: lowered, it would start in the floor; raised by
+  // exactly that, it rests on it.
+  options = DropOptions{};
+  options.seconds = 0.1;
+  options.lift = 0.04;
+  const Result<DropReport> below = simulateDrop(std::span(&body, 1), options);
+  ASSERT_FALSE(below.ok());
+  EXPECT_NE(below.error().message.find("below the floor"), std::string::npos) << below.error().message;
+  options.lift = 0.05;
+  EXPECT_TRUE(simulateDrop(std::span(&body, 1), options).ok());
+  body = box({0.1, 0.1, 0.1}, Mat3::Identity(), Vec3(0, 0, 1.0));
+  options.lift = -0.9;  // lowered: what the start's height asks for
+  EXPECT_TRUE(simulateDrop(std::span(&body, 1), options).ok());
 }
 
 }  // namespace

@@ -22,7 +22,7 @@ struct RigidBody {
 };
 
 struct DropOptions {
-  double lift = 0.3;            ///< every body raised by this much (m); the floor is z = 0
+  double lift = 0.3;            ///< every body raised (or, < 0, lowered) by this much (m); the floor is z = 0
   double seconds = 3.0;         ///< simulated time
   double timeStep = 1.0 / 240;  ///< fixed step (s)
   double friction = 0.6;
@@ -55,7 +55,8 @@ double lowestPoint(const core::CollisionShape& shape, const core::Mat4& pose = c
 /// Steps the bodies in Bullet's discrete dynamics world with a static floor plane. Each body's frame is
 /// its centre of mass and principal axes; its compound's spheres, boxes and capsules are placed in it.
 /// Deterministic: the same bodies and options give the same report. Errors: kInvalidArgument for a
-/// body without positive mass, finite inertia or shapes, or options out of range.
+/// body without positive mass, finite inertia or shapes, a body below the floor once lifted, or options
+/// out of range.
 Result<DropReport> simulateDrop(std::span<const RigidBody> bodies, const DropOptions& options = {});
 
 }  // namespace shapedb::haptics
