@@ -1,11 +1,17 @@
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <pthread.h>
+#include <semaphore>
+#include <string>
 #include <sys/resource.h>
+#include <thread>
 
 #include <shapedb/core/statistics.h>
 #include <shapedb/haptics/contact.h>
@@ -38,34 +44,83 @@ Percentiles percentiles(std::vector<double> values) {
 
 }  // namespace
 
-/// An augmented object as the tick uses it: published once by a worker, then read and stepped by the
-/// tick thread only (the snapshot excepted, which any thread may read).
-struct HapticLoop::Live {
-  AugmentedObject data;
-  std::vector<ModeStep> steps;  ///< per mode, for the loop's period
-  Eigen::VectorXd omegaSquared;
-  Eigen::VectorXd q, v;     ///< modal coordinates and velocities
-  Eigen::VectorXd force;    ///< modal forces gathered during the current tick
-  double peakEnergy = 0.0;  ///< since the object last came to rest
-  bool active = false;
-  bool touched = false;  ///< in contact during the current tick
-  Vec3 center = Vec3::Zero();
-  double reach = 0.0;  ///< bounding radius of the collision compound about `center`
-  core::TetLocator::Hint hint;
-  // Seqlock, without fences (ThreadSanitizer does not model them): odd while the tick writes `snapshot`.
-  std::atomic<std::uint32_t> sequence{0};
-  std::unique_ptr<std::atomic<double>[]> snapshot;
-};
+/// Everything the loop holds. The tick thread, run()'s workers and the callers of the snapshot accessors
+/// share it; the comments on each member say who writes it.
+class HapticLoop::Impl {
+ public:
+  /// An augmented object as the tick uses it: published once by a worker, then read and stepped by the
+  /// tick thread only (the snapshot excepted, which any thread may read).
+  struct Live {
+    AugmentedObject data;
+    std::vector<ModeStep> steps;  ///< per mode, for the loop's period
+    Eigen::VectorXd omegaSquared;
+    Eigen::VectorXd q, v;     ///< modal coordinates and velocities
+    Eigen::VectorXd force;    ///< modal forces gathered during the current tick
+    double peakEnergy = 0.0;  ///< since the object last came to rest
+    bool active = false;
+    bool touched = false;  ///< in contact during the current tick
+    Vec3 center = Vec3::Zero();
+    double reach = 0.0;  ///< bounding radius of the collision compound about `center`
+    core::TetLocator::Hint hint;
+    // Seqlock, without fences (ThreadSanitizer does not model them): odd while the tick writes `snapshot`.
+    std::atomic<std::uint32_t> sequence{0};
+    std::unique_ptr<std::atomic<double>[]> snapshot;
+  };
 
-struct HapticLoop::Slot {
-  std::atomic<State> state{State::kUntouched};
-  std::atomic<Live*> live{nullptr};
-  std::unique_ptr<Live> owned;  ///< set by the worker before `live` is published
-  std::string error;            ///< set by the worker before state becomes kFailed
-  double requestedAt = 0.0;     ///< tick time of the request
-  double readyAt = 0.0;         ///< set before `live` is published
-  Vec3 center = Vec3::Zero();   ///< bounding sphere of the surface
-  double radius = 0.0;
+  struct Slot {
+    std::atomic<State> state{State::kUntouched};
+    std::atomic<Live*> live{nullptr};
+    std::unique_ptr<Live> owned;  ///< set by the worker before `live` is published
+    std::string error;            ///< set by the worker before state becomes kFailed
+    double requestedAt = 0.0;     ///< tick time of the request
+    double readyAt = 0.0;         ///< set before `live` is published
+    Vec3 center = Vec3::Zero();   ///< bounding sphere of the surface
+    double radius = 0.0;
+  };
+
+  Impl(std::span<const SceneObject> objects, ProxyDevice& device, AugmentFunction augment,
+       const LoopOptions& options);
+  LoopReport run(double seconds);
+  LoopReport simulate(double seconds);
+  Vec3 tick(double seconds);
+  const AugmentedObject* augmentation(std::size_t object) const;
+  Eigen::VectorXd modalCoordinates(std::size_t object) const;
+  std::vector<Vec3> deformedSurface(std::size_t object) const;
+
+  /// Augments and publishes; `readySeconds` stamps the time (none: now, on run()'s clock).
+  void serve(std::uint32_t object, std::optional<double> readySeconds);
+  void workerMain();
+  std::uint32_t popRequest();  ///< UINT32_MAX when none
+  void respond(Slot& slot, Live& live, const core::Vec3& proxy, core::Vec3& force);
+  LoopReport report(double seconds, std::size_t ticks, std::size_t misses) const;
+  void resetStatistics(std::size_t expectedTicks);
+
+  std::span<const SceneObject> mObjects;
+  ProxyDevice& mDevice;
+  AugmentFunction mAugment;
+  LoopOptions mOptions;
+  double mPeriod = 0.001;
+
+  std::unique_ptr<Slot[]> mSlots;
+  // Requests: written by the tick (one producer), read by the workers under mPopMutex. Each object is
+  // requested once, so a ring of one place per object never wraps.
+  std::vector<std::uint32_t> mRequests;
+  std::atomic<std::uint32_t> mRequestsWritten{0};
+  std::uint32_t mRequestsRead = 0;  ///< guarded by mPopMutex
+  std::mutex mPopMutex;             ///< workers only: the tick never takes it
+  std::counting_semaphore<> mPending{0};
+  std::atomic<bool> mStopping{false};
+  double mClockOffset = 0.0;  ///< seconds of earlier runs: the loop's time goes on from one run to the next
+  std::chrono::steady_clock::time_point mRunStart;  ///< run(): set before the workers start
+  double mRunOffset = 0.0;
+
+  // The tick's own state (one thread at a time).
+  std::vector<std::uint32_t> mActive;  ///< objects in contact or still vibrating; capacity: all
+  std::vector<float> mTickMicros;      ///< capacity reserved before the ticks
+  std::vector<float> mLateMicros;      ///< run(): how late each tick started
+  std::vector<core::Vec3> mForces;
+  std::size_t mContactTicks = 0;
+  double mMaxForce = 0.0;
 };
 
 Result<std::unique_ptr<HapticLoop>> HapticLoop::create(std::span<const SceneObject> objects,
@@ -87,10 +142,11 @@ Result<std::unique_ptr<HapticLoop>> HapticLoop::create(std::span<const SceneObje
   for (const SceneObject& object : objects)
     if (object.mesh.vertices.empty() || object.mesh.triangles.empty())
       return Error{ErrorCode::kEmptyMesh, object.name + ": the object has no surface"};
-  return std::unique_ptr<HapticLoop>(new HapticLoop(objects, device, std::move(augment), options));
+  return std::unique_ptr<HapticLoop>(
+      new HapticLoop(std::make_unique<Impl>(objects, device, std::move(augment), options)));
 }
 
-HapticLoop::HapticLoop(std::span<const SceneObject> objects, ProxyDevice& device, AugmentFunction augment,
+HapticLoop::Impl::Impl(std::span<const SceneObject> objects, ProxyDevice& device, AugmentFunction augment,
                        const LoopOptions& options)
     : mObjects(objects),
       mDevice(device),
@@ -109,14 +165,12 @@ HapticLoop::HapticLoop(std::span<const SceneObject> objects, ProxyDevice& device
   mActive.reserve(objects.size());
 }
 
-HapticLoop::~HapticLoop() = default;
-
-const AugmentedObject* HapticLoop::augmentation(std::size_t object) const {
+const AugmentedObject* HapticLoop::Impl::augmentation(std::size_t object) const {
   const Live* live = mSlots[object].live.load(std::memory_order_acquire);
   return live ? &live->data : nullptr;
 }
 
-Eigen::VectorXd HapticLoop::modalCoordinates(std::size_t object) const {
+Eigen::VectorXd HapticLoop::Impl::modalCoordinates(std::size_t object) const {
   const Live* live = mSlots[object].live.load(std::memory_order_acquire);
   if (!live) return {};
   Eigen::VectorXd q(live->q.size());
@@ -133,7 +187,7 @@ Eigen::VectorXd HapticLoop::modalCoordinates(std::size_t object) const {
   }
 }
 
-std::vector<Vec3> HapticLoop::deformedSurface(std::size_t object) const {
+std::vector<Vec3> HapticLoop::Impl::deformedSurface(std::size_t object) const {
   const std::vector<Vec3>& rest = mObjects[object].mesh.vertices;
   const AugmentedObject* data = augmentation(object);
   if (!data) return rest;
@@ -144,7 +198,7 @@ std::vector<Vec3> HapticLoop::deformedSurface(std::size_t object) const {
   return out;
 }
 
-void HapticLoop::serve(std::uint32_t object, std::optional<double> readySeconds) {
+void HapticLoop::Impl::serve(std::uint32_t object, std::optional<double> readySeconds) {
   Slot& slot = mSlots[object];
   const SceneObject& scene = mObjects[object];
   const auto fail = [&](std::string message) {
@@ -191,13 +245,13 @@ void HapticLoop::serve(std::uint32_t object, std::optional<double> readySeconds)
   slot.state.store(State::kReady, std::memory_order_release);
 }
 
-std::uint32_t HapticLoop::popRequest() {
+std::uint32_t HapticLoop::Impl::popRequest() {
   std::lock_guard lock(mPopMutex);
   if (mRequestsRead == mRequestsWritten.load(std::memory_order_acquire)) return kNoRequest;
   return mRequests[mRequestsRead++];
 }
 
-void HapticLoop::respond(Slot& slot, Live& live, const Vec3& proxy, Vec3& force) {
+void HapticLoop::Impl::respond(Slot& slot, Live& live, const Vec3& proxy, Vec3& force) {
   const AugmentedObject& data = live.data;
   const SurfaceDistance contact = signedDistance(data.physics.collision.shapes, proxy);
   if (contact.distance >= mOptions.proxyRadius) return;
@@ -234,7 +288,7 @@ void HapticLoop::respond(Slot& slot, Live& live, const Vec3& proxy, Vec3& force)
   }
 }
 
-Vec3 HapticLoop::tick(double seconds) {
+Vec3 HapticLoop::Impl::tick(double seconds) {
   const Vec3 proxy = mDevice.position(seconds);
   Vec3 force = Vec3::Zero();
 
@@ -301,7 +355,7 @@ Vec3 HapticLoop::tick(double seconds) {
   return force;
 }
 
-void HapticLoop::resetStatistics(std::size_t expectedTicks) {
+void HapticLoop::Impl::resetStatistics(std::size_t expectedTicks) {
   // Filled once and cleared: the pages are touched now, so that the ticks do not fault them in.
   mTickMicros.assign(expectedTicks, 0.0f);
   mTickMicros.clear();
@@ -316,7 +370,7 @@ void HapticLoop::resetStatistics(std::size_t expectedTicks) {
   mMaxForce = 0.0;
 }
 
-void HapticLoop::workerMain() {
+void HapticLoop::Impl::workerMain() {
   for (;;) {
     mPending.acquire();
     if (mStopping.load(std::memory_order_acquire)) return;
@@ -326,7 +380,7 @@ void HapticLoop::workerMain() {
   }
 }
 
-LoopReport HapticLoop::run(double seconds) {
+LoopReport HapticLoop::Impl::run(double seconds) {
   const auto ticks = static_cast<std::size_t>(std::ceil(seconds * mOptions.rateHz));
   resetStatistics(ticks + 1);
   const double offset = mClockOffset;
@@ -391,7 +445,7 @@ LoopReport HapticLoop::run(double seconds) {
   return result;
 }
 
-LoopReport HapticLoop::simulate(double seconds) {
+LoopReport HapticLoop::Impl::simulate(double seconds) {
   const auto ticks = static_cast<std::size_t>(std::ceil(seconds * mOptions.rateHz));
   resetStatistics(ticks);
   const double offset = mClockOffset;
@@ -415,7 +469,7 @@ LoopReport HapticLoop::simulate(double seconds) {
   return report(static_cast<double>(ticks) * mPeriod, ticks, 0);
 }
 
-LoopReport HapticLoop::report(double seconds, std::size_t ticks, std::size_t misses) const {
+LoopReport HapticLoop::Impl::report(double seconds, std::size_t ticks, std::size_t misses) const {
   LoopReport r;
   r.seconds = seconds;
   r.ticks = ticks;
@@ -447,6 +501,31 @@ LoopReport HapticLoop::report(double seconds, std::size_t ticks, std::size_t mis
   }
   r.augmentationMillis = percentiles(std::move(latencies));
   return r;
+}
+
+HapticLoop::HapticLoop(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+HapticLoop::~HapticLoop() = default;
+
+LoopReport HapticLoop::run(double seconds) {
+  return mImpl->run(seconds);
+}
+LoopReport HapticLoop::simulate(double seconds) {
+  return mImpl->simulate(seconds);
+}
+Vec3 HapticLoop::tick(double seconds) {
+  return mImpl->tick(seconds);
+}
+std::size_t HapticLoop::objectCount() const {
+  return mImpl->mObjects.size();
+}
+const AugmentedObject* HapticLoop::augmentation(std::size_t object) const {
+  return mImpl->augmentation(object);
+}
+Eigen::VectorXd HapticLoop::modalCoordinates(std::size_t object) const {
+  return mImpl->modalCoordinates(object);
+}
+std::vector<Vec3> HapticLoop::deformedSurface(std::size_t object) const {
+  return mImpl->deformedSurface(object);
 }
 
 }  // namespace shapedb::haptics

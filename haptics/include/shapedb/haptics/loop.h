@@ -7,17 +7,11 @@
 // with the proxy respond through their modes and push back on it. A tick never waits for a worker, and
 // never allocates, locks, logs or throws.
 
-#include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <mutex>
-#include <optional>
-#include <semaphore>
 #include <span>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -122,7 +116,7 @@ class HapticLoop {
   /// by simulate(); until then they wait. Returns the force sent to the device.
   core::Vec3 tick(double seconds);
 
-  std::size_t objectCount() const { return mObjects.size(); }
+  std::size_t objectCount() const;
   /// The object's physical data once augmented, else null. Any thread.
   const AugmentedObject* augmentation(std::size_t object) const;
   /// The object's modal coordinates as the last tick left them (a consistent snapshot, any thread);
@@ -133,44 +127,9 @@ class HapticLoop {
   std::vector<core::Vec3> deformedSurface(std::size_t object) const;
 
  private:
-  struct Live;
-  struct Slot;
-  HapticLoop(std::span<const SceneObject> objects, ProxyDevice& device, AugmentFunction augment,
-             const LoopOptions& options);
-  /// Augments and publishes; `readySeconds` stamps the time (none: now, on run()'s clock).
-  void serve(std::uint32_t object, std::optional<double> readySeconds);
-  void workerMain();
-  std::uint32_t popRequest();  ///< UINT32_MAX when none
-  void respond(Slot& slot, Live& live, const core::Vec3& proxy, core::Vec3& force);
-  LoopReport report(double seconds, std::size_t ticks, std::size_t misses) const;
-  void resetStatistics(std::size_t expectedTicks);
-
-  std::span<const SceneObject> mObjects;
-  ProxyDevice& mDevice;
-  AugmentFunction mAugment;
-  LoopOptions mOptions;
-  double mPeriod = 0.001;
-
-  std::unique_ptr<Slot[]> mSlots;
-  // Requests: written by the tick (one producer), read by the workers under mPopMutex. Each object is
-  // requested once, so a ring of one place per object never wraps.
-  std::vector<std::uint32_t> mRequests;
-  std::atomic<std::uint32_t> mRequestsWritten{0};
-  std::uint32_t mRequestsRead = 0;  ///< guarded by mPopMutex
-  std::mutex mPopMutex;             ///< workers only: the tick never takes it
-  std::counting_semaphore<> mPending{0};
-  std::atomic<bool> mStopping{false};
-  double mClockOffset = 0.0;  ///< seconds of earlier runs: the loop's time goes on from one run to the next
-  std::chrono::steady_clock::time_point mRunStart;  ///< run(): set before the workers start
-  double mRunOffset = 0.0;
-
-  // The tick's own state (one thread at a time).
-  std::vector<std::uint32_t> mActive;  ///< objects in contact or still vibrating; capacity: all
-  std::vector<float> mTickMicros;      ///< capacity reserved before the ticks
-  std::vector<float> mLateMicros;      ///< run(): how late each tick started
-  std::vector<core::Vec3> mForces;
-  std::size_t mContactTicks = 0;
-  double mMaxForce = 0.0;
+  class Impl;  // the tick's state, the request ring, the workers' lock and semaphore: loop.cpp
+  explicit HapticLoop(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> mImpl;
 };
 
 }  // namespace shapedb::haptics
