@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -51,6 +52,13 @@ inline int squaredCodeDistance(std::uint16_t a, std::uint16_t b) {
             dz = ((a >> 10) & 31) - ((b >> 10) & 31);
   return dx * dx + dy * dy + dz * dz;
 }
+
+/// Filled-cell counts of a voxel descriptor per part of four partitions of its grid: the slabs along
+/// x, y and z (16 bins each) and a 4³ block grid. Any partition bounds eq. (5) and (6) from below.
+struct CountProfile {
+  std::array<std::uint8_t, 48> slabs{};
+  std::array<std::uint8_t, 64> blocks{};
+};
 
 // Filled cells per part of four partitions of the grid: slabs along x, y and z (16 bins each; with
 // N > 16 adjacent slabs share a bin) and a coarse 4³ block grid. Counts saturate at 255, which keeps
@@ -153,8 +161,52 @@ const char* toString(SearchMethod method) {
   return "unknown";
 }
 
+// The index's arrays (the layout the header describes) and the search's workings. Built once by
+// IndexBuilder, then shared, read-only, by every copy of the Index and every searching thread.
+struct Index::Impl {
+  struct Query;
+  class TopK;
+
+  explicit Impl(const DescriptorOptions& options);
+  std::size_t size() const { return mIds.size(); }
+  std::size_t memoryBytes() const;
+  Result<std::vector<Match>> search(std::span<const Descriptor> candidates, const SearchOptions& options,
+                                    SearchStats* stats) const;
+
+  Query prepare(const Descriptor& descriptor, int candidate, double momentWeight) const;
+  double momentTerm(const Query& q, std::size_t slot) const;
+  double gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const;
+  double gridBound(const Query& q, std::size_t slot, double moments) const;
+  double countBound(const Query& q, std::uint32_t count) const;
+  double mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const;
+  void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
+  void searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const;
+  void searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const;
+
+  DescriptorOptions mOptions;
+  std::uint32_t mWords = 0;   ///< 64-bit words of occupancy per entry
+  std::vector<EntryId> mIds;  ///< per slot
+  // Voxel kinds, per slot.
+  std::vector<std::uint32_t> mCounts;
+  std::vector<std::uint64_t> mBits;
+  std::vector<CountProfile> mProfiles;
+  std::vector<std::uint64_t> mCentroidBegin;  ///< size() + 1 offsets into mCentroids
+  std::vector<std::uint16_t> mCentroids;
+  std::vector<std::uint32_t> mBucketBegin;  ///< first slot of each filled-cell count, N³ + 2 entries
+  std::vector<Vec3> mLogMoments;            ///< ln of the canonical moments, for the moment term
+  // Moment kind: points in k-d tree order.
+  struct Node {
+    std::uint32_t begin, end;
+    std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
+    int axis = 0;
+    double split = 0.0;
+  };
+  std::vector<Vec3> mMoments;
+  std::vector<Node> mNodes;
+};
+
 // The query, expanded for fast comparison: dense centroids indexed by cell.
-struct Index::Query {
+struct Index::Impl::Query {
   int candidate = 0;
   std::uint32_t count = 0;
   std::vector<std::uint64_t> bits;
@@ -166,7 +218,7 @@ struct Index::Query {
 };
 
 // The k best (distance, entry) pairs seen, sorted; an entry appears once, with its best candidate.
-class Index::TopK {
+class Index::Impl::TopK {
  public:
   explicit TopK(std::size_t k) : mK(k) { mItems.reserve(k + 1); }
 
@@ -208,14 +260,14 @@ class Index::TopK {
   std::vector<Match> mItems;
 };
 
-Index::Index(const DescriptorOptions& options) : mOptions(options) {
+Index::Impl::Impl(const DescriptorOptions& options) : mOptions(options) {
   const int n = options.gridSize;
   mWords = isGrid(options.kind) ? static_cast<std::uint32_t>((n * n * n + 63) / 64) : 0;
   mCentroidBegin.assign(1, 0);
   if (isGrid(options.kind)) mBucketBegin.assign(static_cast<std::size_t>(n * n * n + 2), 0);
 }
 
-std::size_t Index::memoryBytes() const {
+std::size_t Index::Impl::memoryBytes() const {
   return mIds.size() * sizeof(EntryId) + mCounts.size() * sizeof(std::uint32_t) +
          mBits.size() * sizeof(std::uint64_t) + mProfiles.size() * sizeof(CountProfile) +
          mCentroidBegin.size() * sizeof(std::uint64_t) + mCentroids.size() * sizeof(std::uint16_t) +
@@ -223,7 +275,7 @@ std::size_t Index::memoryBytes() const {
          mNodes.size() * sizeof(Node);
 }
 
-Index::Query Index::prepare(const Descriptor& d, int candidate, double momentWeight) const {
+Index::Impl::Query Index::Impl::prepare(const Descriptor& d, int candidate, double momentWeight) const {
   Query q;
   q.candidate = candidate;
   q.moments = d.moments;
@@ -243,7 +295,7 @@ Index::Query Index::prepare(const Descriptor& d, int candidate, double momentWei
 }
 
 // w · Σ |ln mᵢ − ln m'ᵢ| between the query and the entry in `slot`.
-double Index::momentTerm(const Query& q, std::size_t slot) const {
+double Index::Impl::momentTerm(const Query& q, std::size_t slot) const {
   if (q.momentWeight == 0.0) return 0.0;
   return q.momentWeight * (q.logMoments - mLogMoments[slot]).cwiseAbs().sum();
 }
@@ -252,7 +304,7 @@ double Index::momentTerm(const Query& q, std::size_t slot) const {
 // moment term). Stops early, with a partial value that already exceeds `threshold`, once the entry
 // cannot be closer than it: the partial sums only grow, and the same arithmetic on a larger sum never
 // gives a smaller result.
-double Index::gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const {
+double Index::Impl::gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const {
   const std::uint64_t* bits = &mBits[slot * mWords];
   std::uint32_t exclusive = 0;
   for (std::uint32_t w = 0; w < mWords; ++w)
@@ -289,7 +341,7 @@ double Index::gridDistance(const Query& q, std::size_t slot, double threshold, d
 // A lower bound of gridDistance from counts alone: the cells filled in exactly one grid number at
 // least Σ |count_a − count_b| over the parts of any partition of the grid (slabs, blocks); plus the
 // entry's moment term `moments`, the same value gridDistance adds.
-double Index::gridBound(const Query& q, std::size_t slot, double moments) const {
+double Index::Impl::gridBound(const Query& q, std::size_t slot, double moments) const {
   const CountProfile& p = mProfiles[slot];
   const std::uint8_t* a = p.slabs.data();
   const std::uint8_t* b = q.profile.slabs.data();
@@ -303,14 +355,14 @@ double Index::gridBound(const Query& q, std::size_t slot, double moments) const 
 
 // The bound for every entry with `count` filled cells: |count − n_q| cells are filled in one only
 // (the moment term, ≥ 0, left out).
-double Index::countBound(const Query& q, std::uint32_t count) const {
+double Index::Impl::countBound(const Query& q, std::uint32_t count) const {
   return mismatchDistance(absoluteDifference(count, q.count), count + q.count);
 }
 
 // The distance with `exclusive` cells filled in one grid only and no centroid term, `total` = n₁ + n₂:
 // eq. (5) itself, or eq. (6) without its centroid terms. Distances and bounds all go through it, so a
 // bound (a smaller count) never exceeds its distance in floating point.
-double Index::mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const {
+double Index::Impl::mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const {
   if (mOptions.kind == DescriptorKind::kVoxel) return jaccard(exclusive, total);
   return total == 0 ? 0.0 : static_cast<double>(exclusive) / total;
 }
@@ -321,7 +373,7 @@ double Index::mismatchDistance(std::uint32_t exclusive, std::uint32_t total) con
 // scanned by TBB tasks that share the least of their k-th bests: each is an upper bound of the final
 // k-th best, so pruning against it stays exact, and merging the lists gives the same answer as one
 // thread.
-void Index::searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const {
+void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const {
   const auto maxCount = static_cast<std::int64_t>(mBucketBegin.size()) - 2;
   std::int64_t up = std::min<std::int64_t>(q.count, maxCount + 1), down = up - 1;
   const auto bucket = [&](std::int64_t count) {
@@ -393,7 +445,7 @@ void Index::searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool
 }
 
 // Paper §5: only the entries whose filled-cell count is within ±r of the query's, all compared.
-void Index::searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const {
+void Index::Impl::searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const {
   const auto maxCount = static_cast<std::int64_t>(mBucketBegin.size()) - 2;
   const std::int64_t first = std::max<std::int64_t>(0, static_cast<std::int64_t>(q.count) - radius);
   const std::int64_t last = std::min<std::int64_t>(maxCount, static_cast<std::int64_t>(q.count) + radius);
@@ -408,7 +460,7 @@ void Index::searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats
 
 // Nearest moments in the k-d tree: the nearer child first, the farther one only if the squared
 // distance to its splitting plane does not exceed the k-th best.
-void Index::searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const {
+void Index::Impl::searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const {
   if (mNodes.empty()) return;
   std::int32_t stack[128];
   int depth = 0;
@@ -432,8 +484,8 @@ void Index::searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStat
   }
 }
 
-Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates, const SearchOptions& options,
-                                         SearchStats* stats) const {
+Result<std::vector<Match>> Index::Impl::search(std::span<const Descriptor> candidates,
+                                               const SearchOptions& options, SearchStats* stats) const {
   if (candidates.empty())
     return Error{ErrorCode::kInvalidArgument, "search needs at least one query descriptor"};
   if (options.k < 1) return Error{ErrorCode::kInvalidArgument, "k must be at least 1"};
@@ -495,6 +547,23 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
   return out;
 }
 
+Index::Index(const DescriptorOptions& options) : mImpl(std::make_shared<const Impl>(options)) {}
+Index::Index(std::shared_ptr<const Impl> impl) : mImpl(std::move(impl)) {}
+
+const DescriptorOptions& Index::options() const {
+  return mImpl->mOptions;
+}
+std::size_t Index::size() const {
+  return mImpl->size();
+}
+std::size_t Index::memoryBytes() const {
+  return mImpl->memoryBytes();
+}
+Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates, const SearchOptions& options,
+                                         SearchStats* stats) const {
+  return mImpl->search(candidates, options, stats);
+}
+
 IndexBuilder::IndexBuilder(const DescriptorOptions& options) : mOptions(options) {
   const int n = options.gridSize;
   mWords = isGrid(options.kind) ? static_cast<std::uint32_t>((n * n * n + 63) / 64) : 0;
@@ -518,7 +587,8 @@ Status IndexBuilder::add(EntryId id, const Descriptor& d) {
 }
 
 Result<Index> IndexBuilder::build() && {
-  Index index(mOptions);
+  auto impl = std::make_shared<Index::Impl>(mOptions);
+  Index::Impl& index = *impl;
   const std::size_t count = mIds.size();
   {
     std::vector<EntryId> sorted = mIds;
@@ -533,7 +603,7 @@ Result<Index> IndexBuilder::build() && {
     // k-d tree: split the widest axis at the median, (value, id) ordered for determinism.
     index.mIds = mIds;
     index.mMoments = mMoments;
-    if (count == 0) return index;
+    if (count == 0) return Index(std::move(impl));
     struct Range {
       std::uint32_t begin, end;
       std::int32_t node;
@@ -563,7 +633,7 @@ Result<Index> IndexBuilder::build() && {
       const auto left = static_cast<std::int32_t>(index.mNodes.size());
       index.mNodes.push_back({r.begin, mid});
       index.mNodes.push_back({mid, r.end});
-      Index::Node& node = index.mNodes[static_cast<std::size_t>(r.node)];
+      Index::Impl::Node& node = index.mNodes[static_cast<std::size_t>(r.node)];
       node.left = left;
       node.right = left + 1;
       node.axis = axis;
@@ -575,7 +645,7 @@ Result<Index> IndexBuilder::build() && {
       index.mMoments[i] = points[i].first;
       index.mIds[i] = points[i].second;
     }
-    return index;
+    return Index(std::move(impl));
   }
 
   // Voxel kinds: slots sorted by (filled count, id); buckets of equal count.
@@ -605,7 +675,7 @@ Result<Index> IndexBuilder::build() && {
     ++index.mBucketBegin[index.mCounts[slot] + 1];
   for (std::size_t c = 1; c < index.mBucketBegin.size(); ++c)
     index.mBucketBegin[c] += index.mBucketBegin[c - 1];
-  return index;
+  return Index(std::move(impl));
 }
 
 }  // namespace shapedb::core

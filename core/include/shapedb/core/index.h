@@ -1,7 +1,7 @@
 #pragma once
 
-#include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -13,13 +13,6 @@ namespace shapedb::core {
 
 /// A database entry's identifier (its row in the store).
 using EntryId = std::uint32_t;
-
-/// Filled-cell counts of a voxel descriptor per part of four partitions of its grid: the slabs along
-/// x, y and z (16 bins each) and a 4³ block grid. Any partition bounds eq. (5) and (6) from below.
-struct CountProfile {
-  std::array<std::uint8_t, 48> slabs{};
-  std::array<std::uint8_t, 64> blocks{};
-};
 
 /// One search result.
 struct Match {
@@ -99,47 +92,16 @@ class Index {
     return search(std::span<const Descriptor>(&query, 1), options, stats);
   }
 
-  const DescriptorOptions& options() const { return mOptions; }
-  std::size_t size() const { return mIds.size(); }
+  const DescriptorOptions& options() const;
+  std::size_t size() const;
   /// Bytes held by the index's arrays.
   std::size_t memoryBytes() const;
 
  private:
   friend class IndexBuilder;
-  struct Query;
-  class TopK;
-
-  std::uint32_t words() const { return mWords; }
-  Query prepare(const Descriptor& descriptor, int candidate, double momentWeight) const;
-  double momentTerm(const Query& q, std::size_t slot) const;
-  double gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const;
-  double gridBound(const Query& q, std::size_t slot, double moments) const;
-  double countBound(const Query& q, std::uint32_t count) const;
-  double mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const;
-  void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
-  void searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const;
-  void searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const;
-
-  DescriptorOptions mOptions;
-  std::uint32_t mWords = 0;   ///< 64-bit words of occupancy per entry
-  std::vector<EntryId> mIds;  ///< per slot
-  // Voxel kinds, per slot.
-  std::vector<std::uint32_t> mCounts;
-  std::vector<std::uint64_t> mBits;
-  std::vector<CountProfile> mProfiles;
-  std::vector<std::uint64_t> mCentroidBegin;  ///< size() + 1 offsets into mCentroids
-  std::vector<std::uint16_t> mCentroids;
-  std::vector<std::uint32_t> mBucketBegin;  ///< first slot of each filled-cell count, N³ + 2 entries
-  std::vector<Vec3> mLogMoments;            ///< ln of the canonical moments, for the moment term
-  // Moment kind: points in k-d tree order.
-  struct Node {
-    std::uint32_t begin, end;
-    std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
-    int axis = 0;
-    double split = 0.0;
-  };
-  std::vector<Vec3> mMoments;
-  std::vector<Node> mNodes;
+  struct Impl;  // the layout above and the search's workings: index.cpp
+  explicit Index(std::shared_ptr<const Impl> impl);
+  std::shared_ptr<const Impl> mImpl;  ///< shared by copies: an index never changes once built
 };
 
 /// Collects entries and builds an Index. One per build; not thread-safe.
