@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include <shapedb/core/link.h>
 #include <shapedb/io/database.h>
 #include <shapedb/io/mesh_io.h>
 

@@ -1,4 +1,7 @@
 #pragma once
+// Shape descriptors (paper §4) and their similarities (eq. 4-6): what a descriptor holds and how two
+// compare. They are computed from a mesh by volume::Describer (volume/describe.h, on OpenVDB grids);
+// core::Index (index.h) searches many of them.
 
 #include <array>
 #include <cstdint>

@@ -17,6 +17,7 @@
 #include <Eigen/Dense>
 
 #include <shapedb/core/adapt.h>
+#include <shapedb/core/link.h>
 #include <shapedb/core/result.h>
 #include <shapedb/core/spatial.h>
 #include <shapedb/core/triangle_mesh.h>

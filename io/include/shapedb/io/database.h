@@ -12,6 +12,7 @@
 #include <shapedb/core/adapt.h>
 #include <shapedb/core/fidelity.h>
 #include <shapedb/core/index.h>
+#include <shapedb/core/link.h>
 #include <shapedb/core/orientation.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
