@@ -10,6 +10,8 @@ std::string flagHint(const Error& error) {
   if (error.code == ErrorCode::kNotClosed || error.code == ErrorCode::kNonManifold)
     return "; if its vertices only nearly coincide, --weld-tolerance F (say 1e-6) welds them; --repair "
            "closes small holes and remeshes a non-manifold surface";
+  if (error.code == ErrorCode::kInconsistentOrientation)
+    return "; --repair remeshes it as one consistently oriented surface";
   return "";
 }
 

@@ -215,6 +215,14 @@ TEST(QueryCli, BadInputsAreClearErrors) {
   EXPECT_NE(openQuery.err.find("open.obj"), std::string::npos) << openQuery.err;
   EXPECT_NE(openQuery.out.find("good.obj"), std::string::npos) << "the good mesh is still answered";
 
+  // A closed tetrahedron with one face turned over: refused, naming the flag that remeshes it.
+  const auto twistedPath = dir / "twisted.obj";
+  std::ofstream(twistedPath) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 3 4\n";
+  test::ProcessResult twisted = test::runProcess(SHAPEDB_CLI, {"query", db.string(), twistedPath.string()});
+  EXPECT_EQ(twisted.exitCode, 1);
+  EXPECT_NE(twisted.err.find("twisted.obj"), std::string::npos) << twisted.err;
+  EXPECT_NE(twisted.err.find("--repair"), std::string::npos) << twisted.err;
+
   test::ProcessResult material =
       test::runProcess(SHAPEDB_CLI, {"query", db.string(), good.string(), "--material", "cheese"});
   EXPECT_EQ(material.exitCode, 2);
