@@ -71,7 +71,7 @@ void printDropJson(const DropCommandOptions& o, const haptics::DropScene& scene,
   const haptics::DropReport& report = d.report;
   nlohmann::json out = {{"database", o.database},
                         {"bodies", nlohmann::json::array()},
-                        {"skipped", d.skipped},
+                        {"skipped", nlohmann::json::array()},
                         {"at_rest", report.atRest},
                         {"seconds", o.seconds},
                         {"time_step", d.options.timeStep},
@@ -82,6 +82,8 @@ void printDropJson(const DropCommandOptions& o, const haptics::DropScene& scene,
                         {"energy_end", d.energyEnd},
                         {"kinetic_energy_end", report.kineticEnergy.back()},
                         {"frames", report.frames.size()}};
+  for (const haptics::SkippedMesh& s : d.skipped)
+    out["skipped"].push_back(s.name + ": " + s.error.message);
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
     const haptics::BodyOutcome& outcome = report.bodies[b];
     const core::Vec3 com = d.bodies[b].massProperties.centerOfMass;
@@ -114,8 +116,8 @@ void printDropText(const DropCommandOptions& o, const core::Material& material,
   std::printf("deepest into the floor: %.1f mm at an impact, %.2f mm at the end\n", -1000.0 * d.deepest,
               -1000.0 * d.deepestAtEnd);
   if (!o.frames.empty()) std::printf("frames: %zu PNGs in %s\n", d.report.frames.size(), o.frames.c_str());
-  for (const std::string& s : d.skipped)
-    std::printf("skipped %s\n", s.c_str());
+  for (const haptics::SkippedMesh& s : d.skipped)
+    std::printf("skipped %s: %s%s\n", s.name.c_str(), s.error.message.c_str(), flagHint(s.error).c_str());
 }
 
 int runDrop(const DropCommandOptions& o, const CLI::App& app) {
@@ -142,7 +144,7 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
     options.drop.recordEvery = std::max<std::size_t>(1, static_cast<std::size_t>(o.rate / o.frameRate));
   Result<haptics::DropSceneReport> dropped = haptics::dropOnFloor(*db, *scene, options);
   if (!dropped) {
-    printError(dropped.error().message);
+    printError(dropped.error().message + flagHint(dropped.error()));
     return kExitInputError;
   }
   if (!o.frames.empty())

@@ -125,7 +125,7 @@ std::optional<MeshInput> loadMeshInput(const std::string& path, const MeshInputO
     if (mp.error().code == ErrorCode::kInsideOut) hint = "; --flip-inside-out flips it";
     if (mp.error().code == ErrorCode::kNotClosed || mp.error().code == ErrorCode::kNonManifold ||
         mp.error().code == ErrorCode::kInconsistentOrientation)
-      hint = "; --approximate estimates from vertex point masses";
+      hint = "; --approximate estimates from vertex point masses" + flagHint(mp.error());
     printError(path + ": " + mp.error().message + hint);
     return std::nullopt;
   }

@@ -74,18 +74,19 @@ Result<DropSceneReport> dropOnFloor(const io::Database& database, const DropScen
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     Result<io::QueryResult> r = database.query(scene.meshes[i], query);
     if (!r || !r->physics) {
-      out.skipped.push_back(scene.names[i] + ": " +
-                            (r ? std::string("no physical data") : r.error().message));
+      out.skipped.push_back(
+          {scene.names[i], r ? Error{ErrorCode::kInvalidArgument, "no physical data"} : r.error()});
       continue;
     }
     out.bodies.push_back({r->physics->massProperties, r->physics->collision});
     out.source.push_back(i);
   }
   if (out.bodies.empty()) {
+    if (out.skipped.empty()) return Error{ErrorCode::kInvalidArgument, "the drop scene has no meshes"};
     std::string message = "no mesh could be given physical data";
-    for (const std::string& s : out.skipped)
-      message += "\n" + s;
-    return Error{ErrorCode::kInvalidArgument, message};
+    for (const SkippedMesh& s : out.skipped)
+      message += "\n" + s.name + ": " + s.error.message;
+    return Error{out.skipped.front().error.code, message};
   }
 
   // Everything raised together so that its lowest collision point is at `height`.

@@ -89,13 +89,14 @@ TEST(DropScene, AMeshWithoutDataIsSkippedByNameAndNoneWithDataIsAnError) {
   ASSERT_TRUE(dropped.ok()) << dropped.error().message;
   EXPECT_EQ(dropped->source, std::vector<std::size_t>{1});
   ASSERT_EQ(dropped->skipped.size(), 1u);
-  EXPECT_EQ(dropped->skipped[0].rfind("open: ", 0), 0u) << dropped->skipped[0];
+  EXPECT_EQ(dropped->skipped[0].name, "open");
+  EXPECT_EQ(dropped->skipped[0].error.code, ErrorCode::kNotClosed) << dropped->skipped[0].error.message;
 
   scene.meshes = {open, open};
   scene.names = {"first", "second"};
   const Result<DropSceneReport> none = dropOnFloor(db, scene, steelFor(0.2));
   ASSERT_FALSE(none.ok());
-  EXPECT_EQ(none.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(none.error().code, ErrorCode::kNotClosed) << "the first mesh's error";
   EXPECT_NE(none.error().message.find("first: "), std::string::npos) << none.error().message;
   EXPECT_NE(none.error().message.find("second: "), std::string::npos) << none.error().message;
 

@@ -30,11 +30,17 @@ struct DropSceneOptions {
   DropOptions drop;
 };
 
+/// A mesh that got no physical data, and why (its query's error).
+struct SkippedMesh {
+  std::string name;
+  Error error;
+};
+
 /// What was dropped and what became of it.
 struct DropSceneReport {
   std::vector<RigidBody> bodies;              ///< one per mesh that got physical data
   std::vector<std::size_t> source;            ///< the mesh index of each body
-  std::vector<std::string> skipped;           ///< "name: why" for each mesh without physical data
+  std::vector<SkippedMesh> skipped;           ///< each mesh without physical data
   DropOptions options;                        ///< as simulated
   DropReport report;                          ///< per body in the order of `bodies`
   double totalMass = 0.0;                     ///< kg
@@ -47,8 +53,8 @@ struct DropSceneReport {
 /// Queries `database` for every mesh of `scene` (no linking, no fidelity), raises all bodies together
 /// so that their lowest collision point is at options.height, and drops them. A mesh whose query
 /// fails or has no physical data is skipped and listed. Errors: kInvalidArgument when the scene's names
-/// and meshes differ in number, when no mesh gets physical data (the message lists why, mesh by
-/// mesh), and simulateDrop's errors.
+/// and meshes differ in number; when no mesh gets physical data, the first mesh's error, its message
+/// listing why mesh by mesh; simulateDrop's errors.
 Result<DropSceneReport> dropOnFloor(const io::Database& database, const DropScene& scene,
                                     const DropSceneOptions& options);
 
