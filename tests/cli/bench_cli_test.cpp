@@ -12,6 +12,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "cli_test_support.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -38,9 +39,7 @@ std::vector<std::string> splitCsv(const std::string& line) {
 TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
   test::ScratchDir dir("bench-cli");
   const auto db = dir / "small.db";
-  test::ProcessResult built =
-      test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "9", "--families",
-                                     "box,ellipsoid,shard", "--modes", "5", "--quiet"});
+  test::ProcessResult built = test::buildWithCli(db, 9, "box,ellipsoid,shard", 5);
   ASSERT_EQ(built.exitCode, 0) << built.err;
   const auto sphere = dir / "sphere.obj";
   ASSERT_TRUE(io::saveMesh(core::makeIcosphere(0.1, 4), sphere).ok());
@@ -115,10 +114,7 @@ TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
 TEST(BenchCli, UsageAndInputErrorsAreClear) {
   test::ScratchDir dir("bench-cli-errors");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box",
-                                           "--modes", "2", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 2, "box", 2).exitCode, 0);
   test::ProcessResult neither =
       test::runProcess(SHAPEDB_CLI, {"bench", db.string(), "--out", (dir / "o").string()});
   EXPECT_EQ(neither.exitCode, 2);

@@ -18,6 +18,7 @@
 #include <shapedb/volume/modal.h>
 #include <shapedb/volume/tetrahedralize.h>
 
+#include "cli_test_support.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -165,10 +166,7 @@ TEST(BuildCli, AReadOnlyDatabaseIsQueriedAndWritesAreRefusedWithNothingChanged) 
   const auto folder = dir / "shipped";
   std::filesystem::create_directories(folder);
   const auto db = folder / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "4", "--families", "box",
-                                           "--modes", "2", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 4, "box", 2).exitCode, 0);
   const auto mesh = dir / "box.obj";
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.3, 0.2, 0.1}), mesh).ok());
   const std::string before = dumpEntries(db);
@@ -204,9 +202,7 @@ TEST(BuildCli, AReadOnlyDatabaseIsQueriedAndWritesAreRefusedWithNothingChanged) 
 TEST(BuildCli, InfoAndAddEndToEnd) {
   test::ScratchDir dir("build-info");
   const auto db = dir / "small.db";
-  test::ProcessResult built = test::runProcess(
-      SHAPEDB_CLI,
-      {"build", db.string(), "--entries", "4", "--families", "box,prism", "--modes", "3", "--quiet"});
+  test::ProcessResult built = test::buildWithCli(db, 4, "box,prism", 3);
   ASSERT_EQ(built.exitCode, 0) << built.err;
   EXPECT_NE(built.out.find("4 entries built"), std::string::npos) << built.out;
 
@@ -325,10 +321,7 @@ void execSql(const std::filesystem::path& path, const std::string& sql) {
 TEST(UntrustedDatabase, ATriggerViewOrExtraTableIsRefusedAndTheFileLeftUnchanged) {
   test::ScratchDir dir("untrusted");
   const auto clean = dir / "clean.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", clean.string(), "--entries", "2", "--families", "box",
-                                           "--modes", "2", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(clean, 2, "box", 2).exitCode, 0);
   const auto mesh = dir / "box.obj";
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.3, 0.2, 0.1}), mesh).ok());
   const std::vector<std::pair<std::string, std::string>> additions = {
@@ -363,10 +356,7 @@ TEST(UntrustedDatabase, ATriggerViewOrExtraTableIsRefusedAndTheFileLeftUnchanged
 TEST(InfoCli, CheckFindsAByteFlippedInsideABlobAndNamesTheEntry) {
   test::ScratchDir dir("check");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "3", "--families", "box",
-                                           "--modes", "2", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 3, "box", 2).exitCode, 0);
   const test::ProcessResult good = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--check", "--json"});
   ASSERT_EQ(good.exitCode, 0) << good.err;
   const nlohmann::json report = nlohmann::json::parse(good.out)["check"];

@@ -7,6 +7,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "cli_test_support.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -16,9 +17,7 @@ namespace {
 TEST(DropCli, PlateFragmentsFallComeToRestOnTheFloorAndFramesAreWritten) {
   test::ScratchDir dir("drop-cli");
   const auto db = dir / "small.db";
-  const test::ProcessResult built = test::runProcess(
-      SHAPEDB_CLI,
-      {"build", db.string(), "--entries", "24", "--families", "box,prism,shard", "--modes", "2", "--quiet"});
+  const test::ProcessResult built = test::buildWithCli(db, 24, "box,prism,shard", 2);
   ASSERT_EQ(built.exitCode, 0) << built.err;
   const auto plate = dir / "plate.obj";
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.4, 0.3, 0.02}), plate).ok());

@@ -14,6 +14,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "cli_test_support.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -35,8 +36,7 @@ nlohmann::json readJson(const std::filesystem::path& path) {
 TEST(HapticCli, ReportParsedBackForASceneWithAnOpenMesh) {
   test::ScratchDir dir("haptic-cli");
   const auto db = dir / "small.db";
-  test::ProcessResult built = test::runProcess(
-      SHAPEDB_CLI, {"build", db.string(), "--entries", "12", "--families", "box", "--modes", "4", "--quiet"});
+  test::ProcessResult built = test::buildWithCli(db, 12, "box", 4);
   ASSERT_EQ(built.exitCode, 0) << built.err;
 
   // Two boxes 10 × 6 × 4 cm on a line, and an open surface (a tetrahedron missing a face) between them.
@@ -159,10 +159,7 @@ TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoo
             2);
 
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "8", "--families", "shard,box",
-                                           "--modes", "4", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 8, "shard,box", 4).exitCode, 0);
   const auto report = dir / "report.json";
   test::ProcessResult run =
       test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), "--fracture", plate.string(), "--pieces", "6",
@@ -194,10 +191,7 @@ TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoo
 TEST(HapticCli, BadInputsAreClearErrors) {
   test::ScratchDir dir("haptic-cli-bad");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box",
-                                           "--modes", "2", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 2, "box", 2).exitCode, 0);
   const auto scene = dir / "scene";
   std::filesystem::create_directories(scene);
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.1, 0.1, 0.1}), scene / "box.obj").ok());

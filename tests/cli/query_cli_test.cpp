@@ -14,6 +14,7 @@
 #include <shapedb/io/mesh_io.h>
 #include <shapedb/volume/entry.h>
 
+#include "cli_test_support.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -30,9 +31,7 @@ std::string readPrefix(const std::filesystem::path& path, std::size_t n) {
 TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   test::ScratchDir dir("query-cli");
   const auto db = dir / "small.db";
-  test::ProcessResult built = test::runProcess(
-      SHAPEDB_CLI,
-      {"build", db.string(), "--entries", "6", "--families", "box,cylinder", "--modes", "4", "--quiet"});
+  test::ProcessResult built = test::buildWithCli(db, 6, "box,cylinder", 4);
   ASSERT_EQ(built.exitCode, 0) << built.err;
 
   // A box 3 × 2 × 1 m... turned, moved and scaled by 0.1: a 30 × 20 × 10 cm box, far from the origin.
@@ -150,10 +149,7 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
 TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
   test::ScratchDir dir("query-cli-repair");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "4", "--families",
-                                           "ellipsoid,box", "--modes", "4", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 4, "ellipsoid,box", 4).exitCode, 0);
   const core::TriangleMesh closed = core::makeUvEllipsoid({0.12, 0.08, 0.05}, 96, 48);
   core::TriangleMesh holed;
   holed.vertices = closed.vertices;
@@ -194,10 +190,7 @@ TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
 TEST(QueryCli, BadInputsAreClearErrors) {
   test::ScratchDir dir("query-cli-bad");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box",
-                                           "--modes", "2", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 2, "box", 2).exitCode, 0);
   const auto good = dir / "good.obj";
   ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), good).ok());
   // An open surface: a tetrahedron without its fourth face.

@@ -14,6 +14,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "cli_test_support.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -52,10 +53,7 @@ Wav readWav(const std::filesystem::path& path) {
 TEST(SoundCli, TheStrongestPeakOfTheSpectrumIsAnAdaptedModalFrequency) {
   test::ScratchDir dir("sound-cli");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "6", "--families",
-                                           "box,ellipsoid", "--modes", "8", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 6, "box,ellipsoid", 8).exitCode, 0);
   // A rubber block: its modes ring at a few hundred hertz.
   const auto block = dir / "block.obj";
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.4, 0.25, 0.1}), block).ok());
@@ -103,10 +101,7 @@ TEST(SoundCli, TheStrongestPeakOfTheSpectrumIsAnAdaptedModalFrequency) {
 TEST(SoundCli, AnObjectThatRingsAboveHearingIsAClearError) {
   test::ScratchDir dir("sound-cli-errors");
   const auto db = dir / "small.db";
-  ASSERT_EQ(test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "2", "--families", "box",
-                                           "--modes", "4", "--quiet"})
-                .exitCode,
-            0);
+  ASSERT_EQ(test::buildWithCli(db, 2, "box", 4).exitCode, 0);
   const auto bead = dir / "bead.obj";  // a 1 cm steel cube: its first mode is far above 20 kHz
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.01, 0.01, 0.01}), bead).ok());
   test::ProcessResult s =
