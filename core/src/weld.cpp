@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -68,11 +69,19 @@ struct ExactEqual {
   }
 };
 
+// The hash-grid cell of coordinate x. Clamped: a huge coordinate over a small tolerance would not fit
+// in an integer (and converting it would be undefined); clamped cells merely share more candidates, each
+// still checked by distance.
+std::int64_t cellOf(double x, double tolerance) {
+  constexpr double kLimit = 4e18;  // |cell ± 1| stays well inside int64
+  return static_cast<std::int64_t>(std::clamp(std::floor(x / tolerance), -kLimit, kLimit));
+}
+
 }  // namespace
 
 WeldReport weldVertices(TriangleMesh& mesh, double tolerance) {
   std::vector<std::uint32_t> representative(mesh.vertices.size());
-  if (tolerance == 0.0) {
+  if (!(tolerance > 0.0 && std::isfinite(tolerance))) {  // 0 (or, against the contract, NaN or ∞): exact
     std::unordered_map<Vec3, std::uint32_t, ExactHash, ExactEqual> first;
     first.reserve(mesh.vertices.size());
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
@@ -85,9 +94,8 @@ WeldReport weldVertices(TriangleMesh& mesh, double tolerance) {
   const double toleranceSq = tolerance * tolerance;
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Vec3& p = mesh.vertices[v];
-    const std::array<std::int64_t, 3> cell{static_cast<std::int64_t>(std::floor(p.x() / tolerance)),
-                                           static_cast<std::int64_t>(std::floor(p.y() / tolerance)),
-                                           static_cast<std::int64_t>(std::floor(p.z() / tolerance))};
+    const std::array<std::int64_t, 3> cell{cellOf(p.x(), tolerance), cellOf(p.y(), tolerance),
+                                           cellOf(p.z(), tolerance)};
     std::uint32_t best = kNone;
     for (std::int64_t dx = -1; dx <= 1; ++dx)
       for (std::int64_t dy = -1; dy <= 1; ++dy)
@@ -107,6 +115,7 @@ WeldReport weldVertices(TriangleMesh& mesh, double tolerance) {
 }
 
 WeldReport weldVerticesBruteForce(TriangleMesh& mesh, double tolerance) {
+  if (!(tolerance > 0.0 && std::isfinite(tolerance))) tolerance = 0.0;
   std::vector<std::uint32_t> representative(mesh.vertices.size());
   std::vector<std::uint32_t> kept;
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {

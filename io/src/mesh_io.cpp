@@ -199,8 +199,9 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   if (options.weld && !out.topology.isClosed()) {
     const core::Bounds bounds = core::computeBounds(out.mesh);
     core::TriangleMesh welded = out.mesh;
-    const core::WeldReport weld =
-        core::weldVertices(welded, options.weldTolerance * (bounds.max - bounds.min).norm());
+    const core::WeldReport weld = core::weldVertices(
+        welded,
+        options.weldTolerance == 0.0 ? 0.0 : options.weldTolerance * (bounds.max - bounds.min).stableNorm());
     const core::TopologyReport after = core::analyzeTopology(welded);
     if (!welded.triangles.empty() && after.boundaryEdges + after.nonManifoldEdges <
                                          out.topology.boundaryEdges + out.topology.nonManifoldEdges) {

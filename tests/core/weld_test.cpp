@@ -1,6 +1,7 @@
 // Welding: the hash-grid weld against the every-pair oracle, and a soup that becomes a closed surface.
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -71,6 +72,26 @@ TEST(Weld, TheHashGridAgreesWithEveryPairOnRandomClusters) {
     EXPECT_EQ(fast.vertices, plain.vertices);
     EXPECT_EQ(fast.triangles, plain.triangles);
     EXPECT_GT(a.verticesMerged, 0u);
+  }
+}
+
+// Coordinates whose cell index would not fit an integer (1e300 over a tolerance of 1e-6), and
+// tolerances outside the contract (NaN, ∞, negative: exact equals only), agree with the oracle; under
+// UBSan this is also the check that no conversion overflows (a fuzzed OBJ found one).
+TEST(Weld, HugeCoordinatesAndTolerancesOutsideTheContractAgreeWithTheOracle) {
+  TriangleMesh mesh;
+  mesh.vertices = {Vec3(1e300, 0, 0),  Vec3(1e300, 0, 0), Vec3(-1e300, 1e-7, 0),
+                   Vec3(-1e300, 0, 0), Vec3(0, 0, 1),     Vec3(0, 0, 1 + 1e-7)};
+  mesh.triangles = {{0, 2, 4}, {1, 3, 5}, {0, 1, 4}};
+  for (const double tolerance : {1e-6, 0.0, std::nan(""), std::numeric_limits<double>::infinity(), -1.0}) {
+    TriangleMesh fast = mesh, plain = mesh;
+    const WeldReport a = weldVertices(fast, tolerance);
+    const WeldReport b = weldVerticesBruteForce(plain, tolerance);
+    EXPECT_EQ(a.verticesMerged, b.verticesMerged) << tolerance;
+    EXPECT_EQ(fast.vertices, plain.vertices) << tolerance;
+    EXPECT_EQ(fast.triangles, plain.triangles) << tolerance;
+    // The exact duplicate always merges; the near ones only within a finite positive tolerance.
+    EXPECT_EQ(a.verticesMerged, tolerance == 1e-6 ? 3u : 1u) << tolerance;
   }
 }
 

@@ -19,7 +19,8 @@ struct WeldReport {
 /// equal positions), in vertex order, so the result does not depend on hashing; removes the triangles
 /// that this leaves with a repeated corner, and the vertices no triangle uses. Kept vertices keep their
 /// order and positions. Expected O(V + F) (a hash grid of cell `tolerance`), for tolerances under the
-/// mesh's edge lengths. Precondition: indices in range (validateMesh); tolerance ≥ 0 and finite.
+/// mesh's edge lengths. Precondition: indices in range and coordinates finite (validateMesh); a tolerance
+/// that is not finite and positive welds exact equals only.
 WeldReport weldVertices(TriangleMesh& mesh, double tolerance = 0.0);
 
 /// The same by the plain method, every vertex against every kept one: O(V²). The oracle of weldVertices.
