@@ -50,7 +50,9 @@ WeldReport rewrite(TriangleMesh& mesh, const std::vector<std::uint32_t>& represe
 
 struct CellHash {
   std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
-    return static_cast<std::size_t>(c[0] * 73856093LL ^ c[1] * 19349663LL ^ c[2] * 83492791LL);
+    // In unsigned arithmetic, which wraps: a far cell's index times a prime overflows a signed integer.
+    const auto u = [](std::int64_t x) { return static_cast<std::uint64_t>(x); };
+    return static_cast<std::size_t>(u(c[0]) * 73856093u ^ u(c[1]) * 19349663u ^ u(c[2]) * 83492791u);
   }
 };
 
