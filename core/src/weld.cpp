@@ -79,11 +79,18 @@ std::int64_t cellOf(double x, double tolerance) {
   return static_cast<std::int64_t>(std::clamp(std::floor(x / tolerance), -kLimit, kLimit));
 }
 
+// The tolerance both welds use: a finite positive one as given, anything else (0, or against the
+// contract NaN, ∞ or negative) 0, which welds exact equals only.
+double usableTolerance(double tolerance) {
+  return tolerance > 0.0 && std::isfinite(tolerance) ? tolerance : 0.0;
+}
+
 }  // namespace
 
 WeldReport weldVertices(TriangleMesh& mesh, double tolerance) {
+  tolerance = usableTolerance(tolerance);
   std::vector<std::uint32_t> representative(mesh.vertices.size());
-  if (!(tolerance > 0.0 && std::isfinite(tolerance))) {  // 0 (or, against the contract, NaN or ∞): exact
+  if (tolerance == 0.0) {
     std::unordered_map<Vec3, std::uint32_t, ExactHash, ExactEqual> first;
     first.reserve(mesh.vertices.size());
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
@@ -117,7 +124,7 @@ WeldReport weldVertices(TriangleMesh& mesh, double tolerance) {
 }
 
 WeldReport weldVerticesBruteForce(TriangleMesh& mesh, double tolerance) {
-  if (!(tolerance > 0.0 && std::isfinite(tolerance))) tolerance = 0.0;
+  tolerance = usableTolerance(tolerance);
   std::vector<std::uint32_t> representative(mesh.vertices.size());
   std::vector<std::uint32_t> kept;
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {

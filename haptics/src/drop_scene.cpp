@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/triangle_mesh.h>
 #include <shapedb/haptics/drop_scene.h>
 #include <shapedb/io/render.h>
 
@@ -41,11 +42,11 @@ Status saveFrame(const std::vector<const core::TriangleMesh*>& surfaces, const s
 /// A floor under the surfaces' footprint and a backdrop behind them as high as the start.
 core::TriangleMesh makeStage(const std::vector<const core::TriangleMesh*>& surfaces, double height) {
   core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const core::TriangleMesh* surface : surfaces)
-    for (const core::Vec3& p : surface->vertices) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
+  for (const core::TriangleMesh* surface : surfaces) {
+    const core::Bounds box = core::computeBounds(*surface);
+    lo = lo.cwiseMin(box.min);
+    hi = hi.cwiseMax(box.max);
+  }
   const core::Vec3 size = hi - lo;
   const double margin = 0.6 * std::max(size.x(), size.y());
   const core::Vec3 middle = 0.5 * (lo + hi);
