@@ -1,8 +1,10 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <deque>
 #include <list>
 #include <mutex>
+#include <string_view>
 #include <unordered_map>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -40,17 +42,39 @@ double microsecondsSince(Clock::time_point start) {
 
 }  // namespace
 
+/// The writing connection of a Database opened to learn. Left, it leaves the file in rollback-journal
+/// mode again, as a build does (best effort: another connection may still hold it in WAL mode).
+struct LearningWriter {
+  explicit LearningWriter(Store s) : store(std::move(s)) {}
+  LearningWriter(const LearningWriter&) = delete;
+  LearningWriter& operator=(const LearningWriter&) = delete;
+  ~LearningWriter() { static_cast<void>(store.finish()); }
+  Store store;
+};
+
 struct Database::Impl {
-  explicit Impl(Store s) : store(std::move(s)) {}
+  Impl(std::unique_ptr<LearningWriter> w, Store s) : writer(std::move(w)), store(std::move(s)) {}
   Result<std::shared_ptr<const CachedEntry>> cachedEntry(core::EntryId id);
   volume::Describer& describer(core::DescriptorKind kind);
 
+  // Before the reading connection: closed after it, so that it can leave the file's WAL mode.
+  std::unique_ptr<LearningWriter> writer;  ///< with OpenOptions::learn
   Store store;
   /// One Describer per thread and kind: describing reuses its grid's memory instead of allocating.
   tbb::enumerable_thread_specific<Describers> describers;
-  std::vector<EntryRecord> entries;
+  std::vector<EntryRecord> entries;  ///< the file's when opened; never changes
   std::unordered_map<core::EntryId, std::size_t> byId;
-  std::array<std::optional<core::Index>, 3> indexes;
+  std::unordered_map<std::string_view, std::size_t> byName;
+  std::array<std::unique_ptr<core::LiveIndex>, 3> indexes;
+
+  // Learned entries: records at stable addresses (a deque only grows at its end), found by id and name
+  // under learnedMutex, which is held for lookups and insertions only, never while the file is written.
+  std::mutex learnMutex;  ///< one learn() at a time
+  mutable std::mutex learnedMutex;
+  std::deque<EntryRecord> learned;
+  std::unordered_map<core::EntryId, const EntryRecord*> learnedById;
+  std::unordered_map<std::string, const EntryRecord*> learnedByName;
+  core::EntryId nextId = 0;  ///< the next learned entry's (under learnMutex)
   std::size_t cacheCapacity = 64;
   mutable std::mutex cacheMutex;
   mutable std::list<std::pair<core::EntryId, std::shared_ptr<const CachedEntry>>> lru;  // front: newest
@@ -64,6 +88,13 @@ Database& Database::operator=(Database&&) noexcept = default;
 Database::~Database() = default;
 
 Result<Database> Database::open(const std::filesystem::path& path, const OpenOptions& options) {
+  // The writer first: it puts the file in WAL mode, in which the reader then reads beside its writes.
+  std::unique_ptr<LearningWriter> writer;
+  if (options.learn) {
+    auto w = Store::open(path, /*writable=*/true);
+    if (!w) return w.error();
+    writer = std::make_unique<LearningWriter>(std::move(w).value());
+  }
   auto store = Store::open(path);
   if (!store) return store.error();
   const BuildParameters& p = store->parameters();
@@ -76,13 +107,19 @@ Result<Database> Database::open(const std::filesystem::path& path, const OpenOpt
                        core::toString(have.sampling) + " sampling, not grid " +
                        std::to_string(want.gridSize) + " and " + core::toString(want.sampling) + " sampling"};
   }
-  auto impl = std::make_unique<Impl>(std::move(store).value());
+  auto impl = std::make_unique<Impl>(std::move(writer), std::move(store).value());
   impl->cacheCapacity = std::max<std::size_t>(1, options.cacheEntries);
   auto entries = impl->store.entries();
   if (!entries) return entries.error();
   impl->entries = std::move(entries).value();
-  for (std::size_t i = 0; i < impl->entries.size(); ++i)
-    impl->byId.emplace(impl->entries[i].id, i);
+  // Learned ids follow the catalog's and every id already taken, as user entries' do (addToDatabase).
+  impl->nextId = static_cast<core::EntryId>(impl->store.parameters().entries);
+  for (std::size_t i = 0; i < impl->entries.size(); ++i) {
+    const EntryRecord& e = impl->entries[i];
+    impl->byId.emplace(e.id, i);
+    impl->byName.emplace(e.name, i);
+    impl->nextId = std::max(impl->nextId, e.id + 1);
+  }
   for (core::DescriptorKind kind :
        {core::DescriptorKind::kMoment, core::DescriptorKind::kVoxel, core::DescriptorKind::kCentroidVoxel}) {
     core::DescriptorOptions o = impl->store.parameters().entry.descriptor;
@@ -95,7 +132,8 @@ Result<Database> Database::open(const std::filesystem::path& path, const OpenOpt
         return withContext(st.error(), path.string() + ": entry " + std::to_string(id));
     auto index = std::move(builder).build();
     if (!index) return withContext(index.error(), path.string());
-    impl->indexes[static_cast<std::size_t>(kind)].emplace(std::move(index).value());
+    impl->indexes[static_cast<std::size_t>(kind)] =
+        std::make_unique<core::LiveIndex>(std::move(index).value());
   }
   return Database(std::move(impl));
 }
@@ -109,12 +147,69 @@ bool Database::supportsStretchCorrection() const {
 const std::vector<EntryRecord>& Database::entries() const {
   return mImpl->entries;
 }
-const EntryRecord* Database::entry(core::EntryId id) const {
-  const auto it = mImpl->byId.find(id);
-  return it == mImpl->byId.end() ? nullptr : &mImpl->entries[it->second];
+std::vector<EntryRecord> Database::learnedEntries() const {
+  std::lock_guard lock(mImpl->learnedMutex);
+  return {mImpl->learned.begin(), mImpl->learned.end()};
 }
-const core::Index& Database::index(core::DescriptorKind kind) const {
+std::size_t Database::size() const {
+  std::lock_guard lock(mImpl->learnedMutex);
+  return mImpl->entries.size() + mImpl->learned.size();
+}
+const EntryRecord* Database::entry(core::EntryId id) const {
+  if (const auto it = mImpl->byId.find(id); it != mImpl->byId.end()) return &mImpl->entries[it->second];
+  std::lock_guard lock(mImpl->learnedMutex);
+  const auto it = mImpl->learnedById.find(id);
+  return it == mImpl->learnedById.end() ? nullptr : it->second;
+}
+const EntryRecord* Database::entry(std::string_view name) const {
+  if (const auto it = mImpl->byName.find(name); it != mImpl->byName.end()) return &mImpl->entries[it->second];
+  std::lock_guard lock(mImpl->learnedMutex);
+  const auto it = mImpl->learnedByName.find(std::string(name));
+  return it == mImpl->learnedByName.end() ? nullptr : it->second;
+}
+const core::LiveIndex& Database::index(core::DescriptorKind kind) const {
   return *mImpl->indexes[static_cast<std::size_t>(kind)];
+}
+
+Result<core::EntryId> Database::learn(const std::string& name, const std::string& source,
+                                      const volume::EntryData& data) {
+  Impl& s = *mImpl;
+  if (!s.writer)
+    return Error{
+        ErrorCode::kInvalidArgument,
+        s.store.path().string() + ": opened for reading only; open it with OpenOptions::learn to learn"};
+  std::lock_guard lock(s.learnMutex);
+  if (entry(name) != nullptr)
+    return Error{ErrorCode::kInvalidArgument,
+                 s.store.path().string() + ": already holds an entry '" + name + "'"};
+  EntryRecord r;
+  r.id = s.nextId;
+  r.name = name;
+  r.family = volume::Family::kLearned;
+  r.source = source;
+  r.nodes = data.physics.tetMesh.nodeCount();
+  r.tets = data.physics.tetMesh.tetCount();
+  r.times = data.times;
+  if (Status st = s.writer->store.write(std::span<const EntryRecord>(&r, 1),
+                                        std::span<const volume::EntryData>(&data, 1));
+      !st)
+    return st.error();
+  ++s.nextId;
+  {
+    std::lock_guard published(s.learnedMutex);
+    const EntryRecord& stored = s.learned.emplace_back(std::move(r));
+    s.learnedById.emplace(stored.id, &stored);
+    s.learnedByName.emplace(stored.name, &stored);
+  }
+  // The record first, then the descriptors: a search that finds the entry finds its record too.
+  const core::EntryId id = s.nextId - 1;
+  for (std::size_t k = 0; k < s.indexes.size(); ++k) {
+    const std::pair<core::EntryId, core::Descriptor> added(id, data.descriptors[k]);
+    if (Status st = s.indexes[k]->add(std::span(&added, 1)); !st)
+      return withContext(st.error(), s.store.path().string() + ": learned entry '" + name +
+                                         "' (written to the file, not searchable until it is opened again)");
+  }
+  return id;
 }
 
 volume::Describer& Database::Impl::describer(core::DescriptorKind kind) {

@@ -208,12 +208,15 @@ const char* toString(Family family) {
       return "union";
     case Family::kUser:
       return "user";
+    case Family::kLearned:
+      return "learned";
   }
   return "?";
 }
 
 std::optional<Family> parseFamily(std::string_view name) {
   if (name == toString(Family::kUser)) return Family::kUser;
+  if (name == toString(Family::kLearned)) return Family::kLearned;
   for (Family f : kGenerated)
     if (name == toString(f)) return f;
   return std::nullopt;
@@ -226,7 +229,7 @@ Result<std::vector<Family>> parseFamilies(std::string_view list) {
     const std::size_t comma = list.find(',');
     const std::string_view name = list.substr(0, comma);
     const std::optional<Family> f = parseFamily(name);
-    if (!f || *f == Family::kUser) {
+    if (!f || *f == Family::kUser || *f == Family::kLearned) {
       std::string known;
       for (Family g : kGenerated)
         known += (known.empty() ? "" : ", ") + std::string(toString(g));
@@ -332,6 +335,7 @@ ShapeSpec familySpec(Family family, std::uint32_t index) {
     }
     case Family::kShard:
     case Family::kUser:
+    case Family::kLearned:
       break;
   }
   return spec;
@@ -392,9 +396,10 @@ Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolutio
     case Family::kUnion:
       return detail::makeUnionShape(static_cast<int>(a), rng, maxTriangles);
     case Family::kUser:
+    case Family::kLearned:
       break;
   }
-  return Error{ErrorCode::kInvalidArgument, "user entries have no generator"};
+  return Error{ErrorCode::kInvalidArgument, "user and learned entries have no generator"};
 }
 
 }  // namespace shapedb::volume

@@ -23,6 +23,7 @@ enum class ErrorCode {
   kInsideOut,                ///< the signed volume is negative
   kZeroVolume,               ///< the surface encloses no measurable volume
   kInvalidArgument,          ///< a parameter outside its documented range
+  kCancelled,                ///< work abandoned before it was done: its owner shut down first
 };
 
 /// A recoverable failure: a code and a one-line message that names the input and the problem,

@@ -7,12 +7,14 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <shapedb/core/adapt.h>
 #include <shapedb/core/fidelity.h>
 #include <shapedb/core/index.h>
 #include <shapedb/core/link.h>
+#include <shapedb/core/live_index.h>
 #include <shapedb/core/orientation.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
@@ -89,13 +91,17 @@ struct QueryResult {
 };
 
 /// An open database: every entry's descriptors in three in-RAM indexes (one per kind), its physical data
-/// read on demand through a bounded cache. Thread-safe: concurrent searches and physics reads.
+/// read on demand through a bounded cache. Thread-safe: concurrent searches and physics reads, and, opened
+/// with OpenOptions::learn, entries learned beside them (learn).
 class Database {
  public:
   struct OpenOptions {
     std::size_t cacheEntries = 64;  ///< physical data kept in RAM, least recently used dropped first
     /// If set, the file must have been built with these descriptor parameters (grid size, sampling).
     std::optional<core::DescriptorOptions> expectDescriptor;
+    /// Open for learning too (learn(), io/enrich.h): a second, writable connection to the file beside the
+    /// reading one. Errors then include a writable Store::open's (a read-only file or folder).
+    bool learn = false;
   };
   /// Errors: Store::open's, kInvalidArgument (expectDescriptor differs: the message says how), kParse
   /// (a corrupted descriptor).
@@ -110,9 +116,28 @@ class Database {
   /// Whether QueryOptions::stretchCorrection can be used: its basis (core/stretch.h) is that of linear
   /// tets, and a database of quadratic ones stores their modes at the corners only.
   bool supportsStretchCorrection() const;
+  /// The entries the file held when it was opened, in id order.
   const std::vector<EntryRecord>& entries() const;
+  /// The entries learned through this Database since it was opened, in the order they were published.
+  std::vector<EntryRecord> learnedEntries() const;
+  /// Every entry searched now: entries() and learnedEntries().
+  std::size_t size() const;
+  /// Any entry, learned ones included, by id or by name; nullptr if there is none. The pointer stays
+  /// valid as long as the Database.
   const EntryRecord* entry(core::EntryId id) const;
-  const core::Index& index(core::DescriptorKind kind) const;
+  const EntryRecord* entry(std::string_view name) const;
+  /// The index of one descriptor kind: the file's entries and those learned since.
+  const core::LiveIndex& index(core::DescriptorKind kind) const;
+
+  /// Adds an entry computed elsewhere (io/enrich.h computes them) as a `learned` entry: written to the file
+  /// in one transaction (a crash loses it whole or keeps it whole), then published to the indexes. A
+  /// query that starts after learn() returns can match it; one running meanwhile sees it or does not,
+  /// never a part of it. Queries do not wait for it; learns wait for each other.
+  /// `data` must have been computed with parameters().entry (volume::computeEntry) for its data and
+  /// descriptors to mean what the others' do. One process at a time may learn into a file.
+  /// Errors: kInvalidArgument (not opened with OpenOptions::learn; the name is taken), Store::write's.
+  Result<core::EntryId> learn(const std::string& name, const std::string& source,
+                              const volume::EntryData& data);
 
   /// The k most similar entries to `mesh` (any frame, any size) by the descriptor `kind`: exact mass
   /// properties → normalize → describe every orientation candidate → exact search.

@@ -16,8 +16,9 @@ namespace shapedb::volume {
 /// The shape families of the database: the paper's six generic convex families (§6); shards and fragments
 /// for fracture, the "scenario-based database" of its §7; and the non-convex families that real objects
 /// resemble, whose lowest modes live in thin parts (a handle, a limb, a wall, a fin), which no convex
-/// entry has. `kUser` is for the meshes `shapedb add` brings. Stored by name (toString), so the order
-/// here is not part of the file format.
+/// entry has. `kUser` is for the meshes `shapedb add` brings, `kLearned` for the objects a database learned
+/// while it was queried (io/enrich.h). Stored by name (toString), so the order here is not part of the
+/// file format.
 enum class Family : std::uint8_t {
   kBox,
   kEllipsoid,
@@ -35,10 +36,11 @@ enum class Family : std::uint8_t {
   kLimbed,
   kStone,
   kUnion,
-  kUser
+  kUser,
+  kLearned
 };
 
-/// The families a default build uses, in catalog order: all but kUser.
+/// The families a default build uses, in catalog order: all but kUser and kLearned.
 std::span<const Family> generatedFamilies();
 /// The convex families of databases built before the non-convex ones existed: box to fragment.
 std::span<const Family> convexFamilies();
