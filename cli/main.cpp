@@ -23,9 +23,9 @@ int main(int argc, char** argv) {
                                         shapedb::volume::openVdbVersion() + ")");
   app.require_subcommand(1);
   std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
-                                   addInfoCommand(app),    addAddCommand(app),      addQueryCommand(app),
-                                   addHapticCommand(app),  addFractureCommand(app), addBenchCommand(app),
-                                   addSoundCommand(app),   addDropCommand(app)};
+                                   addInfoCommand(app),    addAddCommand(app),      addEnrichCommand(app),
+                                   addQueryCommand(app),   addHapticCommand(app),   addFractureCommand(app),
+                                   addBenchCommand(app),   addSoundCommand(app),    addDropCommand(app)};
 
   try {
     app.parse(argc, argv);

@@ -5,13 +5,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include <shapedb/core/descriptor.h>
 #include <shapedb/io/database.h>
+#include <shapedb/io/enrich.h>
 #include <shapedb/io/mesh_io.h>
 #include <shapedb/io/render.h>
 #include <shapedb/volume/families.h>
@@ -38,6 +41,7 @@ struct QueryCommandOptions {
   bool stretch = false;
   bool correct = false;
   bool table = false;
+  bool enrich = false;
   std::string exportDir;
   std::string png;
 };
@@ -126,11 +130,11 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
                bool timing) {
   std::printf("%s: %zu triangles, volume %.6g m³, size L = %.6g m\n", file.c_str(), mesh.triangleCount(),
               r.massProperties.volume, std::cbrt(r.massProperties.volume));
-  std::printf("  %-4s %-16s %-10s %12s %12s %12s %12s\n", "rank", "entry", "family", "distance", "moment err",
+  std::printf("  %-4s %-24s %-10s %12s %12s %12s %12s\n", "rank", "entry", "family", "distance", "moment err",
               "dev. mean", "dev. max");
   for (std::size_t i = 0; i < r.matches.size(); ++i) {
     const io::MatchReport& m = r.matches[i];
-    std::printf("  %-4zu %-16s %-10s %12.6g", i + 1, m.entry ? m.entry->name.c_str() : "?",
+    std::printf("  %-4zu %-24s %-10s %12.6g", i + 1, m.entry ? m.entry->name.c_str() : "?",
                 m.entry ? volume::toString(m.entry->family) : "?", m.match.distance);
     if (m.fidelity)
       std::printf(" %12s %12s %12s", percent(m.fidelity->maxMomentError).c_str(),
@@ -223,13 +227,13 @@ std::filesystem::path pngPath(const std::string& png, std::size_t index, std::si
 
 /// One line per query: the best match, its fidelity, and the adapted physics in brief.
 void printTableHeader() {
-  std::printf("%-24s %-16s %9s %9s %9s %11s %10s %10s %10s\n", "mesh", "best match", "distance", "dev.mean",
+  std::printf("%-24s %-24s %9s %9s %9s %11s %10s %10s %10s\n", "mesh", "best match", "distance", "dev.mean",
               "mom.err", "mass (kg)", "f1 (Hz)", "f2 (Hz)", "f3 (Hz)");
 }
 
 void printTableRow(const std::string& file, const io::QueryResult& r) {
   const io::MatchReport& m = r.matches.front();
-  std::printf("%-24s %-16s %9.4f", std::filesystem::path(file).filename().string().c_str(),
+  std::printf("%-24s %-24s %9.4f", std::filesystem::path(file).filename().string().c_str(),
               m.entry ? m.entry->name.c_str() : "?", m.match.distance);
   if (m.fidelity)
     std::printf(" %9s %9s", percent(m.fidelity->meanDeviation).c_str(),
@@ -248,7 +252,94 @@ void printTableRow(const std::string& file, const io::QueryResult& r) {
   std::printf("\n");
 }
 
-int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
+/// A query's answer as JSON: its matches, and the physics and correction of the best one.
+nlohmann::json answerJson(const io::QueryResult& r) {
+  nlohmann::json q = {{"matches", nlohmann::json::array()}, {"timing_us", timingJson(r.times)}};
+  for (const io::MatchReport& m : r.matches)
+    q["matches"].push_back(matchJson(m));
+  if (!r.matches.empty() && r.matches.front().fidelity)
+    q["fidelity"] = matchJson(r.matches.front())["fidelity"];
+  if (r.physics) q["physics"] = physicsJson(*r.physics);
+  if (r.correction) q["correction"] = correctionJson(*r.correction);
+  q["link"] = {{"vertices", r.link.locations.size()},
+               {"outside", r.link.outsideCount},
+               {"max_outside_distance", r.link.maxOutsideDistance}};
+  return q;
+}
+
+nlohmann::json queryJson(const std::string& file, const io::LoadedMesh& loaded,
+                         const std::optional<volume::RepairReport>& repaired, const io::QueryResult& r,
+                         const std::string& descriptor) {
+  nlohmann::json q = {{"file", file},
+                      {"triangles", loaded.mesh.triangleCount()},
+                      {"scale", loaded.scale},
+                      {"flipped_inside_out", loaded.flippedInsideOut},
+                      {"welded_vertices", loaded.verticesWelded},
+                      {"volume", r.massProperties.volume},
+                      {"size", std::cbrt(r.massProperties.volume)},
+                      {"descriptor", descriptor}};
+  if (repaired)
+    q["repaired"] = {{"resolution", repaired->resolution},
+                     {"voxel_size", repaired->voxelSize},
+                     {"holes", repaired->holes},
+                     {"closing_radius", repaired->closingRadius},
+                     {"volume_before", repaired->volumeBefore ? nlohmann::json(*repaired->volumeBefore)
+                                                              : nlohmann::json(nullptr)},
+                     {"volume_after", repaired->volumeAfter},
+                     {"area_before", repaired->areaBefore},
+                     {"area_after", repaired->areaAfter}};
+  q.update(answerJson(r));
+  return q;
+}
+
+/// A mesh handed to the enricher by query --enrich: answered again once it is learned.
+struct PendingLearn {
+  std::string file;
+  core::TriangleMesh mesh;
+  std::size_t jsonIndex = 0;
+  std::shared_future<Result<io::Learned>> learned;
+};
+
+/// query --enrich's second half: waits for each mesh to be learned, queries it again and prints both.
+int answerAgain(const QueryCommandOptions& o, const io::Database& db, const io::QueryOptions& options,
+                std::vector<PendingLearn>& pending, nlohmann::json& queries) {
+  int status = kExitOk;
+  for (PendingLearn& p : pending) {
+    const Result<io::Learned>& learned = p.learned.get();
+    if (!learned) {
+      printError(p.file + ": not learned: " + learned.error().message);
+      status = kExitInputError;
+      continue;
+    }
+    auto again = db.query(p.mesh, options);
+    if (!again) {
+      printError(p.file + ": " + again.error().message);
+      status = kExitInputError;
+      continue;
+    }
+    if (o.json) {
+      nlohmann::json& q = queries[p.jsonIndex];
+      q["learned"] = {{"entry_id", learned->id},
+                      {"name", learned->name},
+                      {"computed", learned->computed},
+                      {"seconds", learned->seconds}};
+      q["after_learning"] = answerJson(*again);
+    } else if (o.table) {
+      printTableRow(p.file + " (learned)", *again);
+    } else {
+      if (learned->computed)
+        std::printf("%s: learned as entry %u '%s' in %.1f s; queried again:\n", p.file.c_str(), learned->id,
+                    learned->name.c_str(), learned->seconds);
+      else
+        std::printf("%s: learned before, entry %u '%s'; queried again:\n", p.file.c_str(), learned->id,
+                    learned->name.c_str());
+      printText(p.file, p.mesh, *again, o.timing);
+    }
+  }
+  return status;
+}
+
+io::QueryOptions queryOptionsOf(const QueryCommandOptions& o) {
   io::QueryOptions options;
   options.descriptor = *core::parseDescriptorKind(o.descriptor);
   options.search.k = o.k;
@@ -259,15 +350,29 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   options.fidelity = !o.noFidelity;
   options.stretchCorrection = o.stretch;
   options.correct = o.correct;
+  return options;
+}
+
+int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
+  io::QueryOptions options = queryOptionsOf(o);
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
   options.material = *material;
 
-  auto db = io::Database::open(o.database);
+  io::Database::OpenOptions open;
+  open.learn = o.enrich;
+  auto db = io::Database::open(o.database, open);
   if (!db) {
     printError(db.error().message);
     return kExitInputError;
   }
+  std::optional<io::Enricher> enricher;
+  if (o.enrich) {
+    io::EnricherOptions enrich;
+    enrich.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    enricher.emplace(*db, enrich);
+  }
+  std::vector<PendingLearn> pending;
   nlohmann::json queries = nlohmann::json::array();
   int status = kExitOk;
   if (o.table && !o.json) printTableHeader();
@@ -286,6 +391,10 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
       status = kExitInputError;
       continue;
     }
+    if (enricher)
+      pending.push_back(
+          {file, loaded->mesh, queries.size(),
+           enricher->submit({std::filesystem::path(file).filename().string(), file, loaded->mesh})});
     if (!o.exportDir.empty())
       if (Status st = exportObj(o.exportDir, std::filesystem::path(file).stem().string(), *result); !st) {
         printError(st.error().message);
@@ -296,43 +405,15 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
         printError(st.error().message);
         return kExitInputError;
       }
-    if (o.json) {
-      nlohmann::json q = {{"file", file},
-                          {"triangles", loaded->mesh.triangleCount()},
-                          {"scale", loaded->scale},
-                          {"flipped_inside_out", loaded->flippedInsideOut},
-                          {"welded_vertices", loaded->verticesWelded},
-                          {"volume", result->massProperties.volume},
-                          {"size", std::cbrt(result->massProperties.volume)},
-                          {"descriptor", o.descriptor},
-                          {"matches", nlohmann::json::array()},
-                          {"timing_us", timingJson(result->times)}};
-      if (repaired)
-        q["repaired"] = {{"resolution", repaired->resolution},
-                         {"voxel_size", repaired->voxelSize},
-                         {"holes", repaired->holes},
-                         {"closing_radius", repaired->closingRadius},
-                         {"volume_before", repaired->volumeBefore ? nlohmann::json(*repaired->volumeBefore)
-                                                                  : nlohmann::json(nullptr)},
-                         {"volume_after", repaired->volumeAfter},
-                         {"area_before", repaired->areaBefore},
-                         {"area_after", repaired->areaAfter}};
-      for (const io::MatchReport& m : result->matches)
-        q["matches"].push_back(matchJson(m));
-      if (!result->matches.empty() && result->matches.front().fidelity)
-        q["fidelity"] = matchJson(result->matches.front())["fidelity"];
-      if (result->physics) q["physics"] = physicsJson(*result->physics);
-      if (result->correction) q["correction"] = correctionJson(*result->correction);
-      q["link"] = {{"vertices", result->link.locations.size()},
-                   {"outside", result->link.outsideCount},
-                   {"max_outside_distance", result->link.maxOutsideDistance}};
-      queries.push_back(std::move(q));
-    } else if (o.table) {
+    if (o.json)
+      queries.push_back(queryJson(file, *loaded, repaired, *result, o.descriptor));
+    else if (o.table)
       printTableRow(file, *result);
-    } else {
+    else
       printText(file, loaded->mesh, *result, o.timing);
-    }
   }
+  if (enricher)
+    if (answerAgain(o, *db, options, pending, queries) != kExitOk) status = kExitInputError;
   if (o.json)
     std::printf("%s\n", nlohmann::json{{"database", o.database}, {"queries", queries}}.dump(2).c_str());
   return status;
@@ -392,6 +473,11 @@ Command addQueryCommand(CLI::App& parent) {
          "the entry's (tens of ms per query; where the morph would invert a tet, the entry's own data\n"
          "stand, with a warning). JSON gains \"correction\": the morph's quality and cost")
       ->excludes(app->get_option("--stretch"));
+  app->add_flag("--enrich", o->enrich,
+                "Learn each mesh too: compute its exact data in the background (the database's own\n"
+                "pipeline, seconds a mesh, on all cores), add them to DB as a 'learned' entry (DB must be\n"
+                "writable; a mesh learned before is not computed again), then query the mesh again and\n"
+                "report both answers. JSON gains \"learned\" and \"after_learning\" per mesh");
   return {app, [o, app] { return runQuery(*o, *app); }};
 }
 

@@ -1,5 +1,6 @@
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
@@ -9,7 +10,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/io/enrich.h>
+#include <shapedb/volume/simplify.h>
 
 namespace shapedb::io {
 namespace {
@@ -98,7 +101,20 @@ void Enricher::Impl::work() {
 void Enricher::Impl::run(Job& job) {
   const std::string where = job.mesh.source.empty() ? job.mesh.name : job.mesh.source;
   Result<Learned> result = [&]() -> Result<Learned> {
-    auto data = volume::computeEntry(job.mesh.mesh, entryOptions);
+    const core::TriangleMesh* surface = &job.mesh.mesh;
+    core::TriangleMesh simplified;
+    if (options.maxTriangles > 0 && surface->triangleCount() > options.maxTriangles) {
+      auto mass = core::computeMassProperties(*surface);
+      if (!mass) return withContext(mass.error(), where);
+      volume::SimplifyOptions simplify;
+      simplify.maxTriangles = options.maxTriangles;
+      simplify.maxError = 1e-3 * std::cbrt(mass->volume);
+      auto s = volume::simplify(*surface, simplify);
+      if (!s) return withContext(s.error(), where + ": simplifying its surface");
+      simplified = std::move(s).value();
+      surface = &simplified;
+    }
+    auto data = volume::computeEntry(*surface, entryOptions);
     if (!data) return withContext(data.error(), where);
     auto id = database.learn(job.name, where, *data);
     if (!id) return id.error();

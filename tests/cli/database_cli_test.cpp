@@ -83,28 +83,15 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
                                          "--batch",   "2",  "--quiet"};
 
   // Start a build and kill it for real once a few batches are committed (and the next is in flight).
-  std::vector<std::string> argv = {SHAPEDB_CLI, "build", killed.string()};
+  std::vector<std::string> argv = {"build", killed.string()};
   argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> cargv;
-  for (std::string& a : argv)
-    cargv.push_back(a.data());
-  cargv.push_back(nullptr);
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    ::execv(SHAPEDB_CLI, cargv.data());
-    ::_exit(127);
-  }
+  test::RunningProcess build(SHAPEDB_CLI, argv);
+  ASSERT_TRUE(build.started());
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   std::size_t before = 0;
   while ((before = committedEntries(killed)) < 6 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_EQ(::kill(pid, SIGKILL), 0);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
-      << "the build finished before it was killed";
+  ASSERT_TRUE(build.kill()) << "the build finished before it was killed";
   const std::size_t atKill = committedEntries(killed);
   std::printf("killed with %zu of 24 entries committed\n", atKill);
   ASSERT_GE(atKill, 6u);

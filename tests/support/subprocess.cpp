@@ -3,6 +3,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fcntl.h>
 #include <fstream>
 #include <iterator>
 #include <linux/capability.h>
@@ -85,6 +86,38 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   result.out.assign(std::istreambuf_iterator<char>(out), {});
   result.err.assign(std::istreambuf_iterator<char>(err), {});
   return result;
+}
+
+RunningProcess::RunningProcess(const std::string& program, const std::vector<std::string>& args) {
+  std::vector<std::string> owned = {program};
+  owned.insert(owned.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : owned)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDOUT_FILENO);
+    ::dup2(null, STDERR_FILENO);
+    ::execv(program.c_str(), argv.data());
+    ::_exit(127);
+  }
+  mPid = pid;
+}
+
+RunningProcess::~RunningProcess() {
+  if (mPid > 0) kill();
+}
+
+bool RunningProcess::kill() {
+  if (mPid <= 0) return false;
+  ::kill(mPid, SIGKILL);
+  int status = 0;
+  ::waitpid(mPid, &status, 0);
+  mPid = -1;
+  return WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
 }
 
 }  // namespace shapedb::test

@@ -33,4 +33,20 @@ inline constexpr int kSetupFailedExit = 125;
 ProcessResult runProcess(const std::string& program, const std::vector<std::string>& args,
                          const RunOptions& options = {});
 
+/// A child started and left running, for tests that kill it in the middle of its work: its output goes
+/// to /dev/null. Killed (SIGKILL) and reaped when destroyed, if it still runs.
+class RunningProcess {
+ public:
+  RunningProcess(const std::string& program, const std::vector<std::string>& args);
+  RunningProcess(const RunningProcess&) = delete;
+  RunningProcess& operator=(const RunningProcess&) = delete;
+  ~RunningProcess();
+  bool started() const { return mPid > 0; }
+  /// SIGKILLs the child and reaps it: true if that signal ended it (false: it had exited before).
+  bool kill();
+
+ private:
+  int mPid = -1;
+};
+
 }  // namespace shapedb::test

@@ -1,0 +1,124 @@
+// shapedb enrich and query --enrich, run as the real executable.
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <shapedb/core/primitives.h>
+#include <shapedb/io/store.h>
+
+#include "cli/cli_test_support.h"
+#include "support/mesh_files.h"
+#include "support/synthetic.h"
+#include "support/test_support.h"
+
+namespace shapedb {
+namespace {
+
+// Lopsided blobs of `count` proportions, written as OBJ files: nothing like the boxes of the database.
+std::vector<std::string> writeBlobs(const test::ScratchDir& dir, int count) {
+  std::vector<std::string> files;
+  for (int i = 0; i < count; ++i) {
+    const auto path = dir / ("blob" + std::to_string(i) + ".obj");
+    test::writeFile(
+        path, test::objText(test::makeLopsidedBlob(core::Vec3(1.0, 0.9 - 0.08 * i, 0.3 + 0.05 * i), 3)));
+    files.push_back(path.string());
+  }
+  return files;
+}
+
+std::size_t learnedEntries(const std::filesystem::path& db) {
+  auto store = io::Store::open(db);
+  if (!store) return 0;
+  auto entries = store->entries();
+  if (!entries) return 0;
+  std::size_t n = 0;
+  for (const io::EntryRecord& e : *entries)
+    n += e.family == volume::Family::kLearned ? 1 : 0;
+  return n;
+}
+
+TEST(EnrichCli, KilledMidEnrichmentKeepsWhatItCommittedAndTheRerunComputesOnlyTheRest) {
+  test::ScratchDir dir("enrich-kill");
+  const auto db = dir / "scenario.db";
+  ASSERT_EQ(test::buildWithCli(db, 4, "box", 4).exitCode, 0);
+  const std::vector<std::string> meshes = writeBlobs(dir, 6);
+  std::vector<std::string> args = {"enrich", db.string(), "--workers", "1"};
+  args.insert(args.end(), meshes.begin(), meshes.end());
+
+  {
+    test::RunningProcess enrich(SHAPEDB_CLI, args);
+    ASSERT_TRUE(enrich.started());
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (learnedEntries(db) < 2 && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_TRUE(enrich.kill()) << "the enrichment finished before it was killed";
+  }
+  const std::size_t atKill = learnedEntries(db);
+  std::printf("killed with %zu of 6 meshes learned\n", atKill);
+  ASSERT_GE(atKill, 2u);
+  ASSERT_LT(atKill, 6u);
+  auto store = io::Store::open(db);
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  auto check = store->check();
+  ASSERT_TRUE(check.ok());
+  EXPECT_TRUE(check->ok()) << "the killed run left a damaged file";
+
+  const test::ProcessResult rerun = test::runProcess(SHAPEDB_CLI, args);
+  ASSERT_EQ(rerun.exitCode, 0) << rerun.err;
+  EXPECT_NE(
+      rerun.out.find(std::to_string(6 - atKill) + " learned, " + std::to_string(atKill) + " already there"),
+      std::string::npos)
+      << rerun.out;
+  EXPECT_EQ(learnedEntries(db), 6u);
+}
+
+TEST(EnrichCli, QueryEnrichAnswersTwiceAndTheSecondAnswerIsTheLearnedEntry) {
+  test::ScratchDir dir("enrich-query");
+  const auto db = dir / "scenario.db";
+  ASSERT_EQ(test::buildWithCli(db, 4, "box,cylinder", 4).exitCode, 0);
+  const std::vector<std::string> meshes = writeBlobs(dir, 1);
+  const auto open = dir / "open.obj";
+  core::TriangleMesh lid = core::makeBox(core::Vec3(1.0, 2.0, 3.0));
+  lid.triangles.pop_back();
+  test::writeFile(open, test::objText(lid));
+
+  const test::ProcessResult r =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), meshes[0], open.string(), "--enrich", "--json"});
+  EXPECT_EQ(r.exitCode, 1) << r.err;  // the open mesh
+  EXPECT_NE(r.err.find("open.obj"), std::string::npos) << r.err;
+  const auto json = nlohmann::json::parse(r.out);
+  ASSERT_EQ(json["queries"].size(), 1u);
+  const auto& q = json["queries"][0];
+  EXPECT_NE(q["matches"][0]["family"], "learned");
+  ASSERT_TRUE(q.contains("learned")) << q.dump();
+  EXPECT_TRUE(q["learned"]["computed"].get<bool>());
+  const auto& again = q["after_learning"];
+  EXPECT_EQ(again["matches"][0]["name"], q["learned"]["name"]);
+  EXPECT_EQ(again["matches"][0]["family"], "learned");
+  EXPECT_LT(again["matches"][0]["distance"].get<double>(), 1e-9);
+  EXPECT_NE(again["physics"]["frequencies_hz"][0], q["physics"]["frequencies_hz"][0]);
+
+  // Learned once: the file keeps it, the next query --enrich does not compute it again.
+  const test::ProcessResult second =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), meshes[0], "--enrich", "--json"});
+  ASSERT_EQ(second.exitCode, 0) << second.err;
+  const auto q2 = nlohmann::json::parse(second.out)["queries"][0];
+  EXPECT_EQ(q2["matches"][0]["name"], q["learned"]["name"]);
+  EXPECT_FALSE(q2["learned"]["computed"].get<bool>());
+
+  // A read-only database cannot learn, and says so.
+  std::filesystem::permissions(db, std::filesystem::perms::owner_read | std::filesystem::perms::group_read);
+  test::RunOptions asUser;
+  asUser.obeyFilePermissions = true;
+  const test::ProcessResult readOnly =
+      test::runProcess(SHAPEDB_CLI, {"enrich", db.string(), meshes[0]}, asUser);
+  EXPECT_EQ(readOnly.exitCode, 1);
+  EXPECT_NE(readOnly.err.find("read-only"), std::string::npos) << readOnly.err;
+}
+
+}  // namespace
+}  // namespace shapedb
