@@ -203,7 +203,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
       if (kQueries[k].momentWeight) q.search.momentWeight = *kQueries[k].momentWeight;
       q.correct = kQueries[k].correct;
       q.material = options.material;
-      q.fidelity = false;
+      q.fidelity = true;  // its evidence is recorded; its time is not counted
       Result<QueryResult> r = database.query(shapes[i].mesh, q);
       if (!r)
         e.error = std::string("query (") + core::toString(kQueries[k].kind) + "): " + r.error().message;
@@ -287,7 +287,18 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
             frequencyErrors(m, q.physics->frequenciesHz(), e.truthFrequenciesHz, options.frequencies);
             m.overlap = core::sampleOverlap(shape, core::sampledSolid(q.physics->collision),
                                             options.overlapResolution);
-            m.queryMicros = q.times.total;
+            m.queryMicros = q.times.total - q.times.fidelity;
+            const MatchReport& best = q.matches.front();
+            if (best.fidelity) {
+              m.meanDeviation = best.fidelity->meanDeviation;
+              m.maxDeviation = best.fidelity->maxDeviation;
+              m.maxMomentError = best.fidelity->maxMomentError;
+              m.descriptorDistance = best.fidelity->descriptorDistance;
+            }
+            if (!q.link.locations.empty())
+              m.outsideShare =
+                  static_cast<double>(q.link.outsideCount) / static_cast<double>(q.link.locations.size());
+            if (q.correction) m.morphTargetDistance = q.correction->morph.meanTargetDistance;
             m.matchMicros = q.times.validate + q.times.massProperties + q.times.describe + q.times.search;
             return m;
           };
@@ -387,12 +398,14 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
   if (!file) return Error{ErrorCode::kIo, path.string() + ": cannot open for writing"};
   file << "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
           "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
+          "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,morph_target_"
+          "distance,"
           "status\n";
   for (const FragmentEvaluation& e : evaluations) {
     const std::string head = csvField(e.name) + "," + std::to_string(e.triangles) + "," + number(e.volume) +
                              "," + std::to_string(e.truthTets) + "," + number(e.truthSeconds) + ",";
     if (e.methods.empty()) {
-      file << head << ",,,,,,,,,,,,,,," << csvField(e.error) << "\n";
+      file << head << ",,,,,,,,,,,,,,,,,,,,," << csvField(e.error) << "\n";
       continue;
     }
     for (const MethodEvaluation& m : e.methods) {
@@ -406,7 +419,10 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
            << "," << number(m.overlap.coverage) << "," << number(m.overlap.overshoot) << ","
            << number(m.queryMicros) << "," << number(m.matchMicros) << ","
            << (descriptor ? number(e.truthSeconds * 1e6 / m.queryMicros) : std::string()) << ","
-           << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
+           << number(m.meanDeviation) << "," << number(m.maxDeviation) << "," << number(m.maxMomentError)
+           << "," << number(m.descriptorDistance) << "," << number(m.outsideShare) << ","
+           << number(m.morphTargetDistance) << "," << (e.ok() ? std::string("ok") : csvField(e.error))
+           << "\n";
     }
   }
   file.flush();

@@ -67,7 +67,15 @@ struct MethodEvaluation {
   double maxFrequencyError = kNaN;
   /// The collision proxy (the adapted compound; the baselines' own solid) against the shape's volume.
   core::VolumeOverlap overlap;
-  double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link)
+  /// Descriptors: the best match's fidelity terms (core::Fidelity) and the share of the shape's vertices
+  /// that its link found outside the tets: the evidence a predicted error is made of.
+  double meanDeviation = kNaN, maxDeviation = kNaN, maxMomentError = kNaN, descriptorDistance = kNaN;
+  double outsideShare = kNaN;
+  /// The corrected query: how far the shape's surface stays from the morphed tets, on average (relative
+  /// to L; volume::MorphReport::meanTargetDistance).
+  double morphTargetDistance = kNaN;
+  double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link), fidelity
+                              ///< report aside
   double matchMicros = kNaN;  ///< descriptors: validate, mass properties, describe, search
 };
 
