@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include <shapedb/core/statistics.h>
 #include <shapedb/haptics/scene.h>
 #include <shapedb/io/database.h>
+#include <shapedb/io/enrich.h>
 
 #include "commands.h"
 #include "material_flags.h"
@@ -37,6 +39,7 @@ struct HapticCommandOptions {
   double speed = 0.5;
   bool simulate = false;
   bool correct = false;
+  bool enrich = false;
 };
 
 nlohmann::json percentilesJson(const haptics::Percentiles& p) {
@@ -65,6 +68,11 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
     if (object.state == haptics::ObjectOutcome::State::kReady) {
       j["entry"] = object.source;
       j["augmentation_latency_ms"] = 1e3 * object.augmentationSeconds;
+      if (object.upgraded) {
+        j["first_entry"] = object.firstSource;
+        j["learned_latency_ms"] = 1e3 * object.upgradeSeconds;
+      }
+      if (!object.upgradeError.empty()) j["learn_error"] = object.upgradeError;
     }
     if (object.state == haptics::ObjectOutcome::State::kFailed) j["error"] = object.error;
     objects.push_back(std::move(j));
@@ -85,6 +93,9 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
           {"objects_augmented", r.objectsAugmented},
           {"objects_failed", r.objectsFailed},
           {"objects_pending", r.objectsPending},
+          {"objects_learned", r.upgrades},
+          {"objects_learning", r.upgradesPending},
+          {"learned_latency_ms", percentilesJson(r.upgradeMillis)},
           {"contact_ticks", r.contactTicks},
           {"max_force_n", r.maxForce},
           {"material", material.name},
@@ -95,7 +106,8 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
             {"max_force_n", o.loop.maxForce},
             {"workers", o.loop.workers},
             {"descriptor", o.descriptor},
-            {"correct", o.correct}}},
+            {"correct", o.correct},
+            {"enrich", o.enrich}}},
           {"objects", std::move(objects)}};
 }
 
@@ -141,7 +153,9 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
     printError(scene.error().message);
     return kExitInputError;
   }
-  auto db = io::Database::open(o.database);
+  io::Database::OpenOptions open;
+  open.learn = o.enrich;
+  auto db = io::Database::open(o.database, open);
   if (!db) {
     printError(db.error().message);
     return kExitInputError;
@@ -163,7 +177,13 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   query.material = *material;
   query.fidelity = false;  // the loop needs the data, not the report; it would double the latency
   query.correct = o.correct;
-  auto loop = haptics::HapticLoop::create(*scene, *device, haptics::databaseAugmenter(*db, query), o.loop);
+  // Learning: one background computation at a time, beside the loop's own threads.
+  std::optional<io::Enricher> enricher;
+  if (o.enrich) enricher.emplace(*db);
+  auto loop = haptics::HapticLoop::create(
+      *scene, *device,
+      enricher ? haptics::learningAugmenter(*db, *enricher, query) : haptics::databaseAugmenter(*db, query),
+      o.loop);
   if (!loop) {
     printError(loop.error().message);
     return kExitUsage;
@@ -173,6 +193,12 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
                o.loop.workers == 1 ? "" : "s");
   const haptics::LoopReport r = o.simulate ? (*loop)->simulate(o.seconds) : (*loop)->run(o.seconds);
 
+  if (enricher && enricher->pending() > 0)
+    std::fprintf(
+        stderr,
+        "haptic: %zu objects still being learned: the one under way is finished and kept, the others "
+        "are left for another run (or shapedb enrich)\n",
+        enricher->pending());
   const nlohmann::json j = reportJson(o, r, *material);
   {
     std::ofstream out(o.report);
@@ -189,11 +215,18 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   std::printf("objects %zu: %zu augmented, %zu failed, %zu pending; augmentation ms p50 %.2f p99 %.2f\n",
               r.objects.size(), r.objectsAugmented, r.objectsFailed, r.objectsPending,
               r.augmentationMillis.p50, r.augmentationMillis.p99);
+  if (o.enrich)
+    std::printf(
+        "learned: %zu objects swapped to their exact data (ms from entering reach p50 %.0f, max %.0f), "
+        "%zu still computing\n",
+        r.upgrades, r.upgradeMillis.p50, r.upgradeMillis.max, r.upgradesPending);
   std::printf("contact in %zu ticks, largest force %.3g N; report: %s\n", r.contactTicks, r.maxForce,
               o.report.c_str());
   for (const haptics::ObjectOutcome& object : r.objects)
     if (object.state == haptics::ObjectOutcome::State::kFailed)
       std::fprintf(stderr, "haptic: %s: not augmented: %s\n", object.name.c_str(), object.error.c_str());
+    else if (!object.upgradeError.empty())
+      std::fprintf(stderr, "haptic: %s: not learned: %s\n", object.name.c_str(), object.upgradeError.c_str());
   return kExitOk;
 }
 
@@ -263,6 +296,10 @@ Command addHapticCommand(CLI::App& parent) {
                 "Augment with the geometry correction (shapedb query --correct): modes of the best entry's\n"
                 "tets morphed onto each object, tens of ms more per object on the augmentation workers,\n"
                 "never in the loop's tick");
+  app->add_flag("--enrich", o->enrich,
+                "Learn each object touched: its exact data computed in the background (shapedb enrich; one\n"
+                "at a time), added to DB (which must be writable), and swapped into the loop between two\n"
+                "ticks once ready; the report gives each object's first entry and the latency to its own");
   app->add_flag(
       "--simulate", o->simulate,
       "Simulated clock: deterministic, as fast as the machine goes, augmentation served after 20 ms "

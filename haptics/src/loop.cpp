@@ -69,12 +69,19 @@ class HapticLoop::Impl {
 
   struct Slot {
     std::atomic<State> state{State::kUntouched};
+    /// The data in use: the first published by a worker; then, if better data come, the tick swaps
+    /// `better` in. Both stay owned for the loop's life (other threads may hold either).
     std::atomic<Live*> live{nullptr};
     std::unique_ptr<Live> owned;  ///< set by the worker before `live` is published
-    std::string error;            ///< set by the worker before state becomes kFailed
-    double requestedAt = 0.0;     ///< tick time of the request
-    double readyAt = 0.0;         ///< set before `live` is published
-    Vec3 center = Vec3::Zero();   ///< bounding sphere of the surface
+    std::atomic<Live*> better{nullptr};
+    std::unique_ptr<Live> ownedBetter;  ///< set by the upgrade thread before `better` is published
+    double swappedAt = 0.0;             ///< tick time of the swap (the tick's)
+    bool swapped = false;               ///< the tick's
+    std::string upgradeError;           ///< the upgrade thread's, under mUpgradeMutex
+    std::string error;                  ///< set by the worker before state becomes kFailed
+    double requestedAt = 0.0;           ///< tick time of the request
+    double readyAt = 0.0;               ///< set before `live` is published
+    Vec3 center = Vec3::Zero();         ///< bounding sphere of the surface
     double radius = 0.0;
   };
 
@@ -89,6 +96,11 @@ class HapticLoop::Impl {
 
   /// Augments and publishes; `readySeconds` stamps the time (none: now, on run()'s clock).
   void serve(std::uint32_t object, std::optional<double> readySeconds);
+  /// The tick's form of an object's data, or why they cannot be used.
+  Result<std::unique_ptr<Live>> makeLive(std::uint32_t object, AugmentedObject data) const;
+  /// Makes and publishes the better data of every object whose upgrade is ready (upgrade thread, or
+  /// simulate()'s).
+  void pollUpgrades();
   void workerMain();
   std::uint32_t popRequest();  ///< UINT32_MAX when none
   void respond(Slot& slot, Live& live, const core::Vec3& proxy, core::Vec3& force);
@@ -109,6 +121,8 @@ class HapticLoop::Impl {
   std::uint32_t mRequestsRead = 0;  ///< guarded by mPopMutex
   std::mutex mPopMutex;             ///< workers only: the tick never takes it
   std::counting_semaphore<> mPending{0};
+  mutable std::mutex mUpgradeMutex;       ///< workers and the upgrade thread: the tick never takes it
+  std::vector<std::uint32_t> mUpgrading;  ///< objects whose better data are to come
   std::atomic<bool> mStopping{false};
   double mClockOffset = 0.0;  ///< seconds of earlier runs: the loop's time goes on from one run to the next
   std::chrono::steady_clock::time_point mRunStart;  ///< run(): set before the workers start
@@ -198,32 +212,22 @@ std::vector<Vec3> HapticLoop::Impl::deformedSurface(std::size_t object) const {
   return out;
 }
 
-void HapticLoop::Impl::serve(std::uint32_t object, std::optional<double> readySeconds) {
-  Slot& slot = mSlots[object];
+Result<std::unique_ptr<HapticLoop::Impl::Live>> HapticLoop::Impl::makeLive(std::uint32_t object,
+                                                                           AugmentedObject data) const {
+  const Slot& slot = mSlots[object];
   const SceneObject& scene = mObjects[object];
-  const auto fail = [&](std::string message) {
-    slot.error = std::move(message);
-    slot.state.store(State::kFailed, std::memory_order_release);
-  };
-  Result<AugmentedObject> result = Error{ErrorCode::kInvalidArgument, ""};
-  try {
-    result = mAugment(scene);
-  } catch (const std::exception& e) {
-    return fail(std::string("augmentation threw: ") + e.what());
-  }
-  if (!result) return fail(result.error().message);
-
   auto live = std::make_unique<Live>();
-  live->data = std::move(*result);
+  live->data = std::move(data);
   const core::AdaptedPhysics& physics = live->data.physics;
   const auto modes = physics.eigenvalues.size();
   const auto rows = static_cast<Eigen::Index>(3 * physics.tetMesh.nodeCount());
   if (physics.modeShapes.rows() != rows || physics.modeShapes.cols() != modes || !live->data.locator ||
       live->data.locator->tetCount() != physics.tetMesh.tetCount() || physics.collision.shapes.empty() ||
       live->data.link.locations.size() != scene.mesh.vertices.size())
-    return fail(scene.name + ": augmentation gave inconsistent data (modes, locator, collision or link)");
+    return Error{ErrorCode::kInvalidArgument,
+                 scene.name + ": augmentation gave inconsistent data (modes, locator, collision or link)"};
   if (!(physics.eigenvalues.array() > 0.0).all())
-    return fail(scene.name + ": augmentation gave a non-positive eigenvalue");
+    return Error{ErrorCode::kInvalidArgument, scene.name + ": augmentation gave a non-positive eigenvalue"};
 
   const Eigen::VectorXd zeta = physics.dampingRatios();
   live->omegaSquared = physics.eigenvalues;
@@ -237,12 +241,71 @@ void HapticLoop::Impl::serve(std::uint32_t object, std::optional<double> readySe
     live->snapshot[j].store(0.0, std::memory_order_relaxed);
   live->center = slot.center;
   live->reach = std::max(slot.radius, boundingRadius(physics.collision.shapes, slot.center));
+  return live;
+}
+
+void HapticLoop::Impl::serve(std::uint32_t object, std::optional<double> readySeconds) {
+  Slot& slot = mSlots[object];
+  const auto fail = [&](std::string message) {
+    slot.error = std::move(message);
+    slot.state.store(State::kFailed, std::memory_order_release);
+  };
+  Result<AugmentedObject> result = Error{ErrorCode::kInvalidArgument, ""};
+  try {
+    result = mAugment(mObjects[object]);
+  } catch (const std::exception& e) {
+    return fail(std::string("augmentation threw: ") + e.what());
+  }
+  if (!result) return fail(result.error().message);
+  auto live = makeLive(object, std::move(result).value());
+  if (!live) return fail(live.error().message);
 
   slot.readyAt = readySeconds ? *readySeconds : mRunOffset + secondsBetween(mRunStart, Clock::now());
-  Live* published = live.get();
-  slot.owned = std::move(live);
+  const bool upgrade = (*live)->data.upgrade.has_value();
+  Live* published = live->get();
+  slot.owned = std::move(live).value();
   slot.live.store(published, std::memory_order_release);
   slot.state.store(State::kReady, std::memory_order_release);
+  if (upgrade) {
+    std::lock_guard lock(mUpgradeMutex);
+    mUpgrading.push_back(object);
+  }
+}
+
+void HapticLoop::Impl::pollUpgrades() {
+  std::lock_guard lock(mUpgradeMutex);
+  for (std::size_t i = 0; i < mUpgrading.size();) {
+    const std::uint32_t object = mUpgrading[i];
+    Slot& slot = mSlots[object];
+    const Upgrade& upgrade = *slot.owned->data.upgrade;
+    if (!upgrade.ready()) {
+      ++i;
+      continue;
+    }
+    mUpgrading[i] = mUpgrading.back();
+    mUpgrading.pop_back();
+    Result<std::optional<AugmentedObject>> better = Error{ErrorCode::kInvalidArgument, ""};
+    try {
+      better = upgrade.make();
+    } catch (const std::exception& e) {
+      better = Error{ErrorCode::kInvalidArgument, std::string("the upgrade threw: ") + e.what()};
+    }
+    if (!better) {
+      slot.upgradeError = better.error().message;
+      continue;
+    }
+    if (!better->has_value()) continue;  // the first data were the best
+    AugmentedObject data = std::move(**better);
+    data.upgrade.reset();  // one upgrade an object
+    auto live = makeLive(object, std::move(data));
+    if (!live) {
+      slot.upgradeError = live.error().message;
+      continue;
+    }
+    Live* published = live->get();
+    slot.ownedBetter = std::move(live).value();
+    slot.better.store(published, std::memory_order_release);
+  }
 }
 
 std::uint32_t HapticLoop::Impl::popRequest() {
@@ -296,6 +359,17 @@ Vec3 HapticLoop::Impl::tick(double seconds) {
     Slot& slot = mSlots[i];
     const double distance = (proxy - slot.center).norm();
     if (Live* live = slot.live.load(std::memory_order_acquire)) {
+      if (!slot.swapped) {
+        if (Live* better = slot.better.load(std::memory_order_acquire)) {
+          // Better data: in use from this tick on, from rest. The old data stay owned, so readers that
+          // hold them are safe; an object still vibrating stays in mActive and goes on with the new.
+          better->active = live->active;
+          slot.live.store(better, std::memory_order_release);
+          slot.swapped = true;
+          slot.swappedAt = seconds;
+          live = better;
+        }
+      }
       if (distance < live->reach + mOptions.proxyRadius) respond(slot, *live, proxy, force);
       continue;
     }
@@ -315,7 +389,7 @@ Vec3 HapticLoop::Impl::tick(double seconds) {
 
   // Modal dynamics of every object in contact or still vibrating: one exact step each.
   for (std::size_t a = 0; a < mActive.size();) {
-    Live& live = *mSlots[mActive[a]].owned;
+    Live& live = *mSlots[mActive[a]].live.load(std::memory_order_relaxed);  // the tick's own store
     double energy = 0.0;
     const Eigen::Index modes = live.q.size();
     const std::uint32_t sequence = live.sequence.load(std::memory_order_relaxed);
@@ -391,6 +465,14 @@ LoopReport HapticLoop::Impl::run(double seconds) {
   std::vector<std::thread> workers;
   for (int w = 0; w < mOptions.workers; ++w)
     workers.emplace_back([this] { workerMain(); });
+  // Better data are waited for on a thread of their own: an upgrade may take seconds to be ready, and
+  // must not hold up the first data of other objects.
+  std::thread upgrader([this] {
+    while (!mStopping.load(std::memory_order_acquire)) {
+      pollUpgrades();
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
 
   std::size_t misses = 0, done = 0;
   bool realtime = false;
@@ -438,6 +520,7 @@ LoopReport HapticLoop::Impl::run(double seconds) {
   mPending.release(static_cast<std::ptrdiff_t>(workers.size()));
   for (std::thread& worker : workers)
     worker.join();
+  upgrader.join();
   mClockOffset = offset + seconds;
   LoopReport result = report(seconds, done, misses);
   result.realtimePriority = realtime;
@@ -464,6 +547,7 @@ LoopReport HapticLoop::Impl::simulate(double seconds) {
     const Clock::time_point begin = Clock::now();
     tick(now);
     mTickMicros.push_back(static_cast<float>(1e6 * secondsBetween(begin, Clock::now())));
+    pollUpgrades();  // after the tick, as the upgrade thread publishes between ticks: the next one swaps
   }
   mClockOffset = offset + static_cast<double>(ticks) * mPeriod;
   return report(static_cast<double>(ticks) * mPeriod, ticks, 0);
@@ -480,17 +564,26 @@ LoopReport HapticLoop::Impl::report(double seconds, std::size_t ticks, std::size
   r.contactTicks = mContactTicks;
   r.maxForce = mMaxForce;
   r.forces = mForces;
-  std::vector<double> latencies;
+  std::vector<double> latencies, upgradeLatencies;
+  std::lock_guard lock(mUpgradeMutex);  // for the upgrades' errors and the pending ones
+  r.upgradesPending = mUpgrading.size();
   for (std::size_t i = 0; i < mObjects.size(); ++i) {
     const Slot& slot = mSlots[i];
     ObjectOutcome outcome;
     outcome.name = mObjects[i].name;
     outcome.state = slot.state.load(std::memory_order_acquire);
     if (outcome.state == State::kReady) {
-      outcome.source = slot.owned->data.source;
+      outcome.source = slot.live.load(std::memory_order_acquire)->data.source;
       outcome.augmentationSeconds = slot.readyAt - slot.requestedAt;
       latencies.push_back(1e3 * outcome.augmentationSeconds);
       ++r.objectsAugmented;
+      if (slot.swapped) {
+        outcome.upgraded = true;
+        outcome.firstSource = slot.owned->data.source;
+        outcome.upgradeSeconds = slot.swappedAt - slot.requestedAt;
+        upgradeLatencies.push_back(1e3 * outcome.upgradeSeconds);
+      }
+      outcome.upgradeError = slot.upgradeError;
     } else if (outcome.state == State::kFailed) {
       outcome.error = slot.error;
       ++r.objectsFailed;
@@ -500,6 +593,8 @@ LoopReport HapticLoop::Impl::report(double seconds, std::size_t ticks, std::size
     r.objects.push_back(std::move(outcome));
   }
   r.augmentationMillis = percentiles(std::move(latencies));
+  r.upgrades = upgradeLatencies.size();
+  r.upgradeMillis = percentiles(std::move(upgradeLatencies));
   return r;
 }
 

@@ -1,3 +1,5 @@
+#include <chrono>
+#include <future>
 #include <string>
 #include <system_error>
 
@@ -43,6 +45,28 @@ AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions
     augmented.locator = std::move(*locator);
     augmented.locatorFrame = augmented.physics.placement;
     return augmented;
+  };
+}
+
+AugmentFunction learningAugmenter(const io::Database& database, io::Enricher& enricher,
+                                  io::QueryOptions options) {
+  AugmentFunction nearest = databaseAugmenter(database, options);
+  return [&enricher, nearest](const SceneObject& object) -> Result<AugmentedObject> {
+    Result<AugmentedObject> first = nearest(object);
+    if (!first) return first;
+    if (first->source == io::learnedName(object.mesh)) return first;  // learned already: nothing better
+    const std::shared_future<Result<io::Learned>> learned =
+        enricher.submit({object.name, object.name, object.mesh});
+    const SceneObject* scene = &object;  // the scene outlives the loop
+    first->upgrade =
+        Upgrade{[learned] { return learned.wait_for(std::chrono::seconds(0)) == std::future_status::ready; },
+                [learned, nearest, scene]() -> Result<std::optional<AugmentedObject>> {
+                  if (!learned.get()) return learned.get().error();
+                  Result<AugmentedObject> exact = nearest(*scene);  // matches its learned entry now
+                  if (!exact) return exact.error();
+                  return std::optional<AugmentedObject>(std::move(exact).value());
+                }};
+    return first;
   };
 }
 

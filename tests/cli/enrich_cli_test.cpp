@@ -120,5 +120,33 @@ TEST(EnrichCli, QueryEnrichAnswersTwiceAndTheSecondAnswerIsTheLearnedEntry) {
   EXPECT_NE(readOnly.err.find("read-only"), std::string::npos) << readOnly.err;
 }
 
+TEST(EnrichCli, HapticEnrichSwapsEachObjectsLearnedDataIntoTheLoop) {
+  test::ScratchDir dir("enrich-haptic");
+  const auto db = dir / "scenario.db";
+  ASSERT_EQ(test::buildWithCli(db, 4, "box", 4).exitCode, 0);
+  const auto scene = dir / "scene";
+  std::filesystem::create_directories(scene);
+  for (int i = 0; i < 2; ++i) {
+    core::TriangleMesh prism = core::makeTriangularPrism(0.08, 0.05 + 0.02 * i, 0.1);
+    for (core::Vec3& v : prism.vertices)
+      v.x() += 0.3 * i;
+    test::writeFile(scene / ("prism" + std::to_string(i) + ".obj"), test::objText(prism));
+  }
+  const auto report = dir / "report.json";
+  const test::ProcessResult r =
+      test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), scene.string(), "--report", report.string(),
+                                     "--seconds", "5", "--speed", "1", "--radius", "0.2", "--enrich"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto json = nlohmann::json::parse(test::readFile(report));
+  EXPECT_EQ(json["objects_augmented"], 2);
+  EXPECT_EQ(json["objects_learned"], 2) << json.dump(2);
+  for (const auto& o : json["objects"]) {
+    EXPECT_EQ(o["entry"].get<std::string>().rfind("learned-", 0), 0u) << o.dump();
+    EXPECT_EQ(o["first_entry"].get<std::string>().rfind("box-", 0), 0u) << o.dump();
+    EXPECT_GT(o["learned_latency_ms"].get<double>(), o["augmentation_latency_ms"].get<double>());
+  }
+  EXPECT_EQ(learnedEntries(db), 2u);
+}
+
 }  // namespace
 }  // namespace shapedb

@@ -290,5 +290,126 @@ TEST(HapticLoop, CreateRejectsBadOptionsAndEmptyObjects) {
   EXPECT_NE(r.error().message.find("nothing.obj"), std::string::npos);
 }
 
+// Better data (an object's exact data, learned in the background) come after the first: an augmentation
+// whose upgrade is ready once `go` is set, and then gives the box with modes twice as stiff.
+AugmentFunction upgradingBox(const std::shared_ptr<std::atomic<bool>>& go,
+                             std::atomic<int>* makes = nullptr) {
+  return [go, makes](const SceneObject& object) -> Result<AugmentedObject> {
+    auto first = test::augmentBox(object);
+    if (!first) return first;
+    first->upgrade = Upgrade{[go] { return go->load(); },
+                             [object, makes]() -> Result<std::optional<AugmentedObject>> {
+                               if (makes) ++*makes;
+                               auto better = test::augmentBox(object);
+                               if (!better) return better.error();
+                               better->source = "learned-box";
+                               better->physics.eigenvalues *= 4.0;
+                               return std::optional<AugmentedObject>(std::move(better).value());
+                             }};
+    return first;
+  };
+}
+
+TEST(HapticLoop, BetterDataAreSwappedInWhenReadyAndReported) {
+  const std::vector<SceneObject> objects = {test::boxObject("box", Vec3::Zero(), 0.1)};
+  TrajectoryDevice device = *TrajectoryDevice::fromKeyframes({{0.0, Vec3(0.01, 0.02, 0.053)}});
+  auto go = std::make_shared<std::atomic<bool>>(false);
+  std::atomic<int> makes{0};
+  auto loop = HapticLoop::create(objects, device, upgradingBox(go, &makes), LoopOptions{});
+  ASSERT_TRUE(loop.ok());
+  const LoopReport before = (*loop)->simulate(0.5);
+  ASSERT_EQ(before.objectsAugmented, 1u);
+  EXPECT_EQ(before.upgrades, 0u);
+  EXPECT_EQ(before.upgradesPending, 1u);
+  EXPECT_EQ((*loop)->augmentation(0)->source, "synthetic-box");
+  const double firstOmega = (*loop)->augmentation(0)->physics.eigenvalues[0];
+
+  go->store(true);
+  const LoopReport after = (*loop)->simulate(0.5);
+  EXPECT_EQ(makes.load(), 1);
+  EXPECT_EQ(after.upgrades, 1u);
+  EXPECT_EQ(after.upgradesPending, 0u);
+  const ObjectOutcome& o = after.objects.front();
+  EXPECT_TRUE(o.upgraded);
+  EXPECT_EQ(o.source, "learned-box");
+  EXPECT_EQ(o.firstSource, "synthetic-box");
+  // Requested at t = 0; the upgrade found ready after the tick at t = 0.5, swapped in at the next.
+  EXPECT_NEAR(o.upgradeSeconds, 0.501, 1e-9);
+  EXPECT_EQ((*loop)->augmentation(0)->source, "learned-box");
+  EXPECT_DOUBLE_EQ((*loop)->augmentation(0)->physics.eigenvalues[0], 4.0 * firstOmega);
+  EXPECT_GT(after.contactTicks, 0u);  // the proxy still presses, now on the new modes
+  EXPECT_NE((*loop)->modalCoordinates(0).norm(), 0.0);
+}
+
+TEST(HapticLoop, AnUpgradeThatFailsOrHasNothingBetterKeepsTheFirstData) {
+  const std::vector<SceneObject> objects = {test::boxObject("fails", Vec3::Zero(), 0.1),
+                                            test::boxObject("same", Vec3(0.3, 0.0, 0.0), 0.1)};
+  TrajectoryDevice device = *TrajectoryDevice::fromKeyframes({{0.0, Vec3(0.15, 0.0, 0.0)}});
+  LoopOptions options;
+  options.augmentationRadius = 0.2;
+  auto loop = HapticLoop::create(
+      objects, device,
+      [](const SceneObject& object) -> Result<AugmentedObject> {
+        auto first = test::augmentBox(object);
+        if (!first) return first;
+        const bool fails = object.name == "fails";
+        first->upgrade = Upgrade{[] { return true; },
+                                 [fails]() -> Result<std::optional<AugmentedObject>> {
+                                   if (fails) return Error{ErrorCode::kNotClosed, "fails.obj: not learned"};
+                                   return std::optional<AugmentedObject>();
+                                 }};
+        return first;
+      },
+      options);
+  ASSERT_TRUE(loop.ok());
+  const LoopReport report = (*loop)->simulate(0.2);
+  ASSERT_EQ(report.objectsAugmented, 2u);
+  EXPECT_EQ(report.upgrades, 0u);
+  EXPECT_EQ(report.upgradesPending, 0u);
+  EXPECT_EQ(report.objects[0].upgradeError, "fails.obj: not learned");
+  EXPECT_TRUE(report.objects[1].upgradeError.empty());
+  for (const ObjectOutcome& o : report.objects) {
+    EXPECT_FALSE(o.upgraded);
+    EXPECT_EQ(o.source, "synthetic-box");
+  }
+}
+
+// The real-time loop with its own threads: the upgrade becomes ready while the proxy presses the box, the
+// upgrade thread publishes it and a tick swaps it in; readers meanwhile see one data set or the other,
+// whole (the tsan preset runs this).
+TEST(HapticLoop, UpgradesInRealTimeWhileReadersWatch) {
+  const std::vector<SceneObject> objects = {test::boxObject("box", Vec3::Zero(), 0.1)};
+  TrajectoryDevice device = *TrajectoryDevice::fromKeyframes({{0.0, Vec3(0.01, 0.02, 0.053)}});
+  auto go = std::make_shared<std::atomic<bool>>(false);
+  auto loop = HapticLoop::create(objects, device, upgradingBox(go), LoopOptions{});
+  ASSERT_TRUE(loop.ok());
+  std::atomic<bool> done{false};
+  std::atomic<int> inconsistent{0};
+  std::thread reader([&] {
+    while (!done.load()) {
+      if (const AugmentedObject* data = (*loop)->augmentation(0)) {
+        const Eigen::VectorXd q = (*loop)->modalCoordinates(0);
+        if (q.size() != data->physics.eigenvalues.size()) ++inconsistent;
+      }
+      std::this_thread::yield();
+    }
+  });
+  std::thread trigger([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    go->store(true);
+  });
+  const LoopReport report = (*loop)->run(0.5);
+  trigger.join();
+  done = true;
+  reader.join();
+  EXPECT_EQ(inconsistent.load(), 0);
+  ASSERT_EQ(report.objectsAugmented, 1u);
+  EXPECT_EQ(report.upgrades, 1u);
+  EXPECT_TRUE(report.objects.front().upgraded);
+  EXPECT_GT(report.objects.front().upgradeSeconds, 0.1);
+  EXPECT_LT(report.objects.front().upgradeSeconds, 0.5);
+  EXPECT_EQ((*loop)->augmentation(0)->source, "learned-box");
+}
+
 }  // namespace
 }  // namespace shapedb::haptics

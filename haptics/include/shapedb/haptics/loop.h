@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -32,6 +33,18 @@ struct SceneObject {
   core::TriangleMesh mesh;
 };
 
+struct AugmentedObject;
+
+/// Better data to come for an object already augmented: its exact data, say, being computed in the
+/// background (io/enrich.h). The loop's upgrade thread polls `ready` every few milliseconds; once it holds,
+/// it calls `make` once, and data that call gives replace the object's between two ticks.
+struct Upgrade {
+  std::function<bool()> ready;  ///< cheap, non-blocking
+  /// The better data (same object, world frame), or nullopt if there are none after all (the first
+  /// answer was already the best); an error keeps the first data and is reported.
+  std::function<Result<std::optional<AugmentedObject>>()> make;
+};
+
 /// What augmentation gives an object: physical data that fit its surface, in the world frame.
 struct AugmentedObject {
   std::string source;            ///< where the data came from (a database entry's name)
@@ -42,6 +55,9 @@ struct AugmentedObject {
   /// locator's frame to the world, and its tets are numbered as physics.tetMesh's.
   std::shared_ptr<const core::TetLocator> locator;
   core::Placement locatorFrame;
+  /// Better data to come, if any (run() and simulate() wait for them; see Upgrade). The swap costs the
+  /// tick two pointer loads and no allocation; the object then starts again from rest on its new modes.
+  std::optional<Upgrade> upgrade;
 };
 
 /// Runs on a worker thread: may take milliseconds, allocate, read files. An error leaves the object
@@ -55,7 +71,7 @@ struct LoopOptions {
   double proxyRadius = 0.005;  ///< the proxy is a sphere (metres)
   double stiffness = 2000.0;   ///< contact penalty, N/m
   double maxForce = 10.0;      ///< the device's limit, N
-  int workers = 1;             ///< augmentation threads (run() only)
+  int workers = 1;             ///< augmentation threads (run() only); upgrades have one thread of their own
   /// run(): sleep until this close to a tick's start, then spin on the clock.
   double spinSeconds = 200e-6;
   /// simulate(): the simulated time from an object's request to its data being ready.
@@ -74,18 +90,27 @@ struct ObjectOutcome {
   std::string source;                ///< kReady: where the data came from
   std::string error;                 ///< kFailed: why
   double augmentationSeconds = 0.0;  ///< kReady: entering the radius → data published
+  /// Better data swapped in (AugmentedObject::upgrade): `source` is then theirs, and `firstSource` the
+  /// first data's.
+  bool upgraded = false;
+  std::string firstSource;
+  double upgradeSeconds = 0.0;  ///< upgraded: entering the radius → better data in use
+  std::string upgradeError;     ///< the upgrade's error, if it gave one (the first data stay)
 };
 
 struct LoopReport {
   double seconds = 0.0;  ///< of the run (wall clock, or simulated)
   std::size_t ticks = 0;
   double achievedRateHz = 0.0;
-  Percentiles tickMicros;          ///< compute time of a tick (wall clock, also in simulate())
-  Percentiles startLateMicros;     ///< run(): how late a tick started after its scheduled time
-  std::size_t deadlineMisses = 0;  ///< ticks that ended after their period did (run() only)
-  bool realtimePriority = false;   ///< run(): the loop thread got SCHED_FIFO
-  std::size_t pageFaults = 0;      ///< run(): page faults of the loop thread (each can stall it)
-  Percentiles augmentationMillis;  ///< entering the radius → data ready, over the objects augmented
+  Percentiles tickMicros;           ///< compute time of a tick (wall clock, also in simulate())
+  Percentiles startLateMicros;      ///< run(): how late a tick started after its scheduled time
+  std::size_t deadlineMisses = 0;   ///< ticks that ended after their period did (run() only)
+  bool realtimePriority = false;    ///< run(): the loop thread got SCHED_FIFO
+  std::size_t pageFaults = 0;       ///< run(): page faults of the loop thread (each can stall it)
+  Percentiles augmentationMillis;   ///< entering the radius → data ready, over the objects augmented
+  std::size_t upgrades = 0;         ///< objects whose better data were swapped in (so far, over all runs)
+  Percentiles upgradeMillis;        ///< entering the radius → better data in use, over those objects
+  std::size_t upgradesPending = 0;  ///< objects whose better data are still to come
   std::size_t objectsAugmented = 0, objectsFailed = 0, objectsPending = 0;
   std::size_t contactTicks = 0;  ///< ticks with a force on the proxy
   double maxForce = 0.0;         ///< N
@@ -109,6 +134,7 @@ class HapticLoop {
 
   /// The same loop on a simulated clock, in the calling thread: tick k at k / rateHz, and a request made
   /// at time t is served (in this thread) at the first tick after t + simulatedAugmentationSeconds.
+  /// Upgrades are polled after every tick, in this thread too (the next tick swaps them in).
   /// Deterministic: the same inputs give the same forces, to the bit.
   LoopReport simulate(double seconds);
 

@@ -9,6 +9,7 @@
 #include <shapedb/core/result.h>
 #include <shapedb/haptics/loop.h>
 #include <shapedb/io/database.h>
+#include <shapedb/io/enrich.h>
 #include <shapedb/io/mesh_io.h>
 
 namespace shapedb::haptics {
@@ -26,5 +27,13 @@ Result<std::vector<SceneObject>> loadScene(const std::filesystem::path& director
 /// `options.link` are forced on. The database must outlive the function; it is safe to call from
 /// several workers at once.
 AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions options);
+
+/// databaseAugmenter, and each object's exact data learned meanwhile: the object goes to `enricher`
+/// (which learns into `database`, opened with Database::OpenOptions::learn), and once its entry is
+/// learned the object is queried again and those data replace the first (AugmentedObject::upgrade). An
+/// object whose first match is already its own learned entry gets no upgrade. The database, the
+/// enricher and the scene's objects must outlive the loop.
+AugmentFunction learningAugmenter(const io::Database& database, io::Enricher& enricher,
+                                  io::QueryOptions options);
 
 }  // namespace shapedb::haptics
