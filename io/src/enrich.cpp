@@ -126,11 +126,14 @@ void Enricher::Impl::run(Job& job) {
     learned.stages = data->times;
     return learned;
   }();
-  const bool ok = result.ok();
+  // The books first, then the answer: whoever sees the answer and submits again finds the entry in the
+  // database (or the failure remembered), not a computation that looks as if it were still running.
+  {
+    std::lock_guard lock(mutex);
+    if (!result.ok()) failed.emplace(job.name, inFlight.at(job.name));
+    inFlight.erase(job.name);  // learned: the database knows it from now on
+  }
   job.promise.set_value(std::move(result));
-  std::lock_guard lock(mutex);
-  if (!ok) failed.emplace(job.name, inFlight.at(job.name));
-  inFlight.erase(job.name);  // learned: the database knows it from now on
 }
 
 Enricher::Enricher(Database& database, const EnricherOptions& options)
