@@ -5,6 +5,7 @@
 
 #include <shapedb/haptics/scene.h>
 #include <shapedb/io/mesh_io.h>
+#include <shapedb/volume/families.h>
 
 namespace shapedb::haptics {
 
@@ -27,45 +28,62 @@ Result<std::vector<SceneObject>> loadScene(const fs::path& directory, const io::
   return objects;
 }
 
+namespace {
+
+/// A learned entry this close to an object (descriptor distance) is the object itself, moved or scaled:
+/// the same surface anywhere matches its entry at round-off, a different one at 1e-3 or more.
+constexpr double kSelfDistance = 1e-6;
+
+/// An object's data from the database's answer to it; `best`, if given, gets the answer's best match.
+Result<AugmentedObject> augmentFrom(const io::Database& database, const io::QueryOptions& options,
+                                    const SceneObject& object, io::MatchReport* best = nullptr) {
+  Result<io::QueryResult> result = database.query(object.mesh, options);
+  if (!result) return withContext(result.error(), object.name);
+  if (result->matches.empty() || !result->physics)
+    return Error{ErrorCode::kInvalidArgument, object.name + ": the database gave no match"};
+  const io::MatchReport& match = result->matches.front();
+  Result<std::shared_ptr<const core::TetLocator>> locator = database.locator(match.match.entry);
+  if (!locator) return withContext(locator.error(), object.name);
+  AugmentedObject augmented;
+  augmented.source = match.entry ? match.entry->name : std::to_string(match.match.entry);
+  augmented.physics = std::move(*result->physics);
+  augmented.link = std::move(result->link);
+  augmented.locator = std::move(*locator);
+  augmented.locatorFrame = augmented.physics.placement;
+  if (best) *best = match;
+  return augmented;
+}
+
+}  // namespace
+
 AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions options) {
   options.adapt = true;
   options.link = true;
-  return [&database, options](const SceneObject& object) -> Result<AugmentedObject> {
-    Result<io::QueryResult> result = database.query(object.mesh, options);
-    if (!result) return withContext(result.error(), object.name);
-    if (result->matches.empty() || !result->physics)
-      return Error{ErrorCode::kInvalidArgument, object.name + ": the database gave no match"};
-    const io::MatchReport& best = result->matches.front();
-    Result<std::shared_ptr<const core::TetLocator>> locator = database.locator(best.match.entry);
-    if (!locator) return withContext(locator.error(), object.name);
-    AugmentedObject augmented;
-    augmented.source = best.entry ? best.entry->name : std::to_string(best.match.entry);
-    augmented.physics = std::move(*result->physics);
-    augmented.link = std::move(result->link);
-    augmented.locator = std::move(*locator);
-    augmented.locatorFrame = augmented.physics.placement;
-    return augmented;
-  };
+  return [&database, options](const SceneObject& object) { return augmentFrom(database, options, object); };
 }
 
 AugmentFunction learningAugmenter(const io::Database& database, io::Enricher& enricher,
                                   io::QueryOptions options) {
-  AugmentFunction nearest = databaseAugmenter(database, options);
-  return [&enricher, nearest](const SceneObject& object) -> Result<AugmentedObject> {
-    Result<AugmentedObject> first = nearest(object);
+  options.adapt = true;
+  options.link = true;
+  return [&database, &enricher, options](const SceneObject& object) -> Result<AugmentedObject> {
+    io::MatchReport best;
+    Result<AugmentedObject> first = augmentFrom(database, options, object, &best);
     if (!first) return first;
-    if (first->source == io::learnedName(object.mesh)) return first;  // learned already: nothing better
+    // Learned already, here or elsewhere in the scene (a copy of it moved): nothing better to come.
+    if (best.entry && best.entry->family == volume::Family::kLearned && best.match.distance < kSelfDistance)
+      return first;
     const std::shared_future<Result<io::Learned>> learned =
         enricher.submit({object.name, object.name, object.mesh});
     const SceneObject* scene = &object;  // the scene outlives the loop
-    first->upgrade =
-        Upgrade{[learned] { return learned.wait_for(std::chrono::seconds(0)) == std::future_status::ready; },
-                [learned, nearest, scene]() -> Result<std::optional<AugmentedObject>> {
-                  if (!learned.get()) return learned.get().error();
-                  Result<AugmentedObject> exact = nearest(*scene);  // matches its learned entry now
-                  if (!exact) return exact.error();
-                  return std::optional<AugmentedObject>(std::move(exact).value());
-                }};
+    first->upgrade = Upgrade{
+        [learned] { return learned.wait_for(std::chrono::seconds(0)) == std::future_status::ready; },
+        [learned, &database, options, scene]() -> Result<std::optional<AugmentedObject>> {
+          if (!learned.get()) return learned.get().error();
+          Result<AugmentedObject> exact = augmentFrom(database, options, *scene);  // its learned entry now
+          if (!exact) return exact.error();
+          return std::optional<AugmentedObject>(std::move(exact).value());
+        }};
     return first;
   };
 }

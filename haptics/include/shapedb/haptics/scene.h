@@ -31,8 +31,9 @@ AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions
 /// databaseAugmenter, and each object's exact data learned meanwhile: the object goes to `enricher`
 /// (which learns into `database`, opened with Database::OpenOptions::learn), and once its entry is
 /// learned the object is queried again and those data replace the first (AugmentedObject::upgrade). An
-/// object whose first match is already its own learned entry gets no upgrade. The database, the
-/// enricher and the scene's objects must outlive the loop.
+/// object whose first match is a learned entry at a distance of round-off (itself, or a copy of it
+/// elsewhere in the scene, learned before) gets no upgrade. The database, the enricher and the scene's
+/// objects must outlive the loop.
 AugmentFunction learningAugmenter(const io::Database& database, io::Enricher& enricher,
                                   io::QueryOptions options);
 
