@@ -38,5 +38,20 @@ TEST(Statistics, NonFiniteValuesAreLeftOut) {
   EXPECT_TRUE(std::isnan(percentile({nan}, 0.5)));
 }
 
+TEST(Statistics, SpearmanOfRanksWithTiesAtTheirMeanRank) {
+  // Monotone relations are ±1 whatever their shape.
+  EXPECT_DOUBLE_EQ(spearman({1, 2, 3, 4}, {10, 100, 1000, 1e6}), 1.0);
+  EXPECT_DOUBLE_EQ(spearman({1, 2, 3, 4}, {4, 3, 2, 1}), -1.0);
+  // The textbook formula 1 − 6Σd²/(n(n²−1)) holds without ties: ranks (1..5) and (2,1,4,3,5), Σd² = 4.
+  EXPECT_NEAR(spearman({1, 2, 3, 4, 5}, {20, 10, 40, 30, 50}), 1.0 - 6.0 * 4.0 / (5.0 * 24.0), 1e-12);
+  // Ties: x ranks (1.5, 1.5, 3), y ranks (1, 2, 3); Pearson of those by hand is 0.8660254.
+  EXPECT_NEAR(spearman({7, 7, 9}, {1, 2, 3}), std::sqrt(3.0) / 2.0, 1e-12);
+  // Non-finite pairs are left out; too few pairs, or a constant side, give NaN.
+  EXPECT_DOUBLE_EQ(spearman({1, NAN, 2, 3}, {1, 5, 2, 3}), 1.0);
+  EXPECT_TRUE(std::isnan(spearman({1}, {1})));
+  EXPECT_TRUE(std::isnan(spearman({1, 1, 1}, {1, 2, 3})));
+  EXPECT_TRUE(std::isnan(spearman({1, 2}, {1, 2, 3})));
+}
+
 }  // namespace
 }  // namespace shapedb::core

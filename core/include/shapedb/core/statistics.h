@@ -16,4 +16,9 @@ double percentile(std::vector<double> values, double q);
 /// values are left out; NaN when none is left.
 double median(std::vector<double> values);
 
+/// Spearman's rank correlation of two paired samples: Pearson's correlation of their ranks, ties given
+/// their mean rank. Pairs with a non-finite value are left out; NaN when fewer than two pairs are left,
+/// or either side is constant. Throws nothing; sizes must match (else NaN).
+double spearman(const std::vector<double>& a, const std::vector<double>& b);
+
 }  // namespace shapedb::core
