@@ -1,0 +1,44 @@
+#pragma once
+// How wrong an answer probably is: a calibrated estimate of the first-frequency error of a query's
+// physical data, from what the query knows about its match (the fidelity report, the link, the geometry
+// correction's morph). What decides whether an object is worth learning exactly (io/enrich.h).
+
+#include <array>
+#include <optional>
+
+namespace shapedb::core {
+
+/// The evidence an estimate is made of, all relative to the query's size L = V^(1/3) where lengths.
+struct ErrorEvidence {
+  double meanDeviation = 0.0;       ///< Fidelity::meanDeviation
+  double maxDeviation = 0.0;        ///< Fidelity::maxDeviation
+  double maxMomentError = 0.0;      ///< Fidelity::maxMomentError
+  double descriptorDistance = 0.0;  ///< Fidelity::descriptorDistance (the grid's part of the distance)
+  double outsideShare = 0.0;        ///< share of the query's vertices outside the adapted tets (the link)
+  /// Corrected answers only: volume::MorphReport::meanTargetDistance.
+  std::optional<double> morphTargetDistance;
+};
+
+inline constexpr int kErrorFeatures = 7;
+using ErrorFeatures = std::array<double, kErrorFeatures>;
+
+/// The model's features: 1, ln(meanDeviation + 1e-3), ln(maxDeviation + 1e-3), ln(maxMomentError +
+/// 1e-3), ln(descriptorDistance + 1e-2), outsideShare, ln(morphTargetDistance + 1e-3) (0 when not
+/// corrected). Logarithms: the errors span three decades and grow with the evidence's own scale.
+ErrorFeatures errorFeatures(const ErrorEvidence& evidence);
+
+/// Weights of the features for the nearest entry's answer and the corrected one: ln|error| ≈ w · f.
+struct ErrorModel {
+  ErrorFeatures nearest{};
+  ErrorFeatures corrected{};
+};
+
+/// The model shapedb ships, fitted on benchmark data (its provenance, fit and held-out quality in
+/// docs/accuracy.md, "Predicted error"; refit with bench/error_model_fit.cpp).
+const ErrorModel& defaultErrorModel();
+
+/// exp(w · f), the weights chosen by whether the evidence is of a corrected answer: the predicted
+/// magnitude of the first non-rigid frequency's relative error (0.1: 10 %).
+double predictFrequencyError(const ErrorEvidence& evidence, const ErrorModel& model = defaultErrorModel());
+
+}  // namespace shapedb::core

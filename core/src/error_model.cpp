@@ -1,0 +1,42 @@
+#include <algorithm>
+#include <cmath>
+
+#include <shapedb/core/error_model.h>
+
+namespace shapedb::core {
+
+ErrorFeatures errorFeatures(const ErrorEvidence& e) {
+  const auto ln = [](double x, double floor) { return std::log(std::max(x, 0.0) + floor); };
+  return {1.0,
+          ln(e.meanDeviation, 1e-3),
+          ln(e.maxDeviation, 1e-3),
+          ln(e.maxMomentError, 1e-3),
+          ln(e.descriptorDistance, 1e-2),
+          e.outsideShare,
+          e.morphTargetDistance ? ln(*e.morphTargetDistance, 1e-3) : 0.0};
+}
+
+const ErrorModel& defaultErrorModel() {
+  // Fitted with bench/error_model_fit on `shapedb bench` results against the 1,100-entry default database:
+  // 50 fragments each of a plate and a sphere and 11 real meshes (the fit), 29 fragments of a scanned
+  // figure held out (bench/results/epyc-2core/error_model_2026-11-26.md). The nearest entry's answer: the
+  // mean surface deviation alone (no other term ranked held-out shapes better, and the full set flipped
+  // signs between splits). The corrected answer: mean and max deviation and the morph's remaining
+  // distance.
+  static const ErrorModel model = {
+      /*nearest=*/{1.36192, 1.4063, 0, 0, 0, 0, 0},
+      /*corrected=*/{0.816174, 0.71731, 0.7854, 0, 0, 0, 0.197589},
+  };
+  return model;
+}
+
+double predictFrequencyError(const ErrorEvidence& evidence, const ErrorModel& model) {
+  const ErrorFeatures f = errorFeatures(evidence);
+  const ErrorFeatures& w = evidence.morphTargetDistance ? model.corrected : model.nearest;
+  double s = 0.0;
+  for (int i = 0; i < kErrorFeatures; ++i)
+    s += w[static_cast<std::size_t>(i)] * f[static_cast<std::size_t>(i)];
+  return std::exp(s);
+}
+
+}  // namespace shapedb::core

@@ -1,0 +1,59 @@
+// The predicted error's model: its features and its arithmetic (its quality is measured on benchmark
+// data: docs/accuracy.md).
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include <shapedb/core/error_model.h>
+
+namespace shapedb::core {
+namespace {
+
+TEST(ErrorModel, FeaturesAreTheLogarithmsOfTheEvidence) {
+  ErrorEvidence e;
+  e.meanDeviation = 0.02;
+  e.maxDeviation = 0.1;
+  e.maxMomentError = 0.3;
+  e.descriptorDistance = 0.5;
+  e.outsideShare = 0.25;
+  const ErrorFeatures f = errorFeatures(e);
+  EXPECT_EQ(f[0], 1.0);
+  EXPECT_DOUBLE_EQ(f[1], std::log(0.021));
+  EXPECT_DOUBLE_EQ(f[2], std::log(0.101));
+  EXPECT_DOUBLE_EQ(f[3], std::log(0.301));
+  EXPECT_DOUBLE_EQ(f[4], std::log(0.51));
+  EXPECT_EQ(f[5], 0.25);
+  EXPECT_EQ(f[6], 0.0);  // not corrected
+  e.morphTargetDistance = 0.004;
+  EXPECT_DOUBLE_EQ(errorFeatures(e)[6], std::log(0.005));
+  // Evidence of a perfect match stays finite.
+  for (double x : errorFeatures(ErrorEvidence{}))
+    EXPECT_TRUE(std::isfinite(x));
+}
+
+TEST(ErrorModel, ThePredictionIsTheExponentialOfTheWeightedFeaturesOfItsKind) {
+  ErrorModel model;
+  model.nearest = {std::log(0.05), 1.0, 0, 0, 0, 0, 0};
+  model.corrected = {std::log(0.02), 0, 0, 0, 0, 0, 0.5};
+  ErrorEvidence e;
+  e.meanDeviation = 0.099;  // ln(0.1)
+  EXPECT_NEAR(predictFrequencyError(e, model), 0.05 * 0.1, 1e-15);
+  e.morphTargetDistance = 0.003;  // a corrected answer: the other weights, ln(0.004) · 0.5
+  EXPECT_NEAR(predictFrequencyError(e, model), 0.02 * std::sqrt(0.004), 1e-15);
+}
+
+TEST(ErrorModel, TheShippedModelGrowsWithTheSurfaceDeviationOfACorrectedAnswer) {
+  // The one trend the benchmark data show clearly (docs/accuracy.md): the farther the morphed entry
+  // stays from the query's surface, the larger the corrected answer's error.
+  ErrorEvidence close, far;
+  close.morphTargetDistance = 0.002;
+  close.meanDeviation = 0.01;
+  far.morphTargetDistance = 0.05;
+  far.meanDeviation = 0.1;
+  EXPECT_LT(predictFrequencyError(close), predictFrequencyError(far));
+  EXPECT_GT(predictFrequencyError(close), 0.0);
+}
+
+}  // namespace
+}  // namespace shapedb::core
