@@ -40,6 +40,7 @@ struct HapticCommandOptions {
   bool simulate = false;
   bool correct = false;
   bool enrich = false;
+  double enrichAbove = 0.0;
 };
 
 nlohmann::json percentilesJson(const haptics::Percentiles& p) {
@@ -107,7 +108,8 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
             {"workers", o.loop.workers},
             {"descriptor", o.descriptor},
             {"correct", o.correct},
-            {"enrich", o.enrich}}},
+            {"enrich", o.enrich},
+            {"enrich_above", o.enrichAbove}}},
           {"objects", std::move(objects)}};
 }
 
@@ -180,10 +182,11 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   // Learning: one background computation at a time, beside the loop's own threads.
   std::optional<io::Enricher> enricher;
   if (o.enrich) enricher.emplace(*db);
-  auto loop = haptics::HapticLoop::create(
-      *scene, *device,
-      enricher ? haptics::learningAugmenter(*db, *enricher, query) : haptics::databaseAugmenter(*db, query),
-      o.loop);
+  auto loop =
+      haptics::HapticLoop::create(*scene, *device,
+                                  enricher ? haptics::learningAugmenter(*db, *enricher, query, o.enrichAbove)
+                                           : haptics::databaseAugmenter(*db, query),
+                                  o.loop);
   if (!loop) {
     printError(loop.error().message);
     return kExitUsage;
@@ -300,6 +303,12 @@ Command addHapticCommand(CLI::App& parent) {
                 "Learn each object touched: its exact data computed in the background (shapedb enrich; one\n"
                 "at a time), added to DB (which must be writable), and swapped into the loop between two\n"
                 "ticks once ready; the report gives each object's first entry and the latency to its own");
+  app->add_option("--enrich-above", o->enrichAbove,
+                  "With --enrich: learn only the objects whose answer's predicted first-frequency error is\n"
+                  "above this fraction (the fidelity report is then computed for each); 0: all")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0))
+      ->needs(app->get_option("--enrich"));
   app->add_flag(
       "--simulate", o->simulate,
       "Simulated clock: deterministic, as fast as the machine goes, augmentation served after 20 ms "

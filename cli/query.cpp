@@ -42,6 +42,7 @@ struct QueryCommandOptions {
   bool correct = false;
   bool table = false;
   bool enrich = false;
+  double enrichAbove = 0.0;
   std::string exportDir;
   std::string png;
 };
@@ -153,6 +154,9 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
                 p.tetMesh.nodeCount(), p.tetMesh.tetCount(), p.collision.shapes.size(), p.collision.coverage,
                 p.collision.overshoot);
     const Eigen::VectorXd hz = p.frequenciesHz();
+    if (r.predictedFrequencyError)
+      std::printf("    predicted first-frequency error: about %.0f %% (from the fidelity report)\n",
+                  100.0 * *r.predictedFrequencyError);
     std::printf("    frequencies (Hz):");
     for (Eigen::Index i = 0; i < std::min<Eigen::Index>(hz.size(), 8); ++i)
       std::printf(" %.5g", hz[i]);
@@ -261,6 +265,7 @@ nlohmann::json answerJson(const io::QueryResult& r) {
     q["fidelity"] = matchJson(r.matches.front())["fidelity"];
   if (r.physics) q["physics"] = physicsJson(*r.physics);
   if (r.correction) q["correction"] = correctionJson(*r.correction);
+  if (r.predictedFrequencyError) q["predicted_frequency_error"] = *r.predictedFrequencyError;
   q["link"] = {{"vertices", r.link.locations.size()},
                {"outside", r.link.outsideCount},
                {"max_outside_distance", r.link.maxOutsideDistance}};
@@ -391,10 +396,16 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
       status = kExitInputError;
       continue;
     }
-    if (enricher)
+    // Learned unless its answer is predicted to be good enough already (--enrich-above).
+    const bool learn = enricher && (o.enrichAbove <= 0.0 || !result->predictedFrequencyError ||
+                                    *result->predictedFrequencyError > o.enrichAbove);
+    if (learn)
       pending.push_back(
           {file, loaded->mesh, queries.size(),
            enricher->submit({std::filesystem::path(file).filename().string(), file, loaded->mesh})});
+    else if (enricher && !o.json)
+      std::fprintf(stderr, "shapedb: %s: not learned: predicted error %.1f %% is within --enrich-above\n",
+                   file.c_str(), 100.0 * *result->predictedFrequencyError);
     if (!o.exportDir.empty())
       if (Status st = exportObj(o.exportDir, std::filesystem::path(file).stem().string(), *result); !st) {
         printError(st.error().message);
@@ -478,6 +489,12 @@ Command addQueryCommand(CLI::App& parent) {
                 "pipeline, seconds a mesh, on all cores), add them to DB as a 'learned' entry (DB must be\n"
                 "writable; a mesh learned before is not computed again), then query the mesh again and\n"
                 "report both answers. JSON gains \"learned\" and \"after_learning\" per mesh");
+  app->add_option("--enrich-above", o->enrichAbove,
+                  "With --enrich: learn only the meshes whose answer's predicted first-frequency error\n"
+                  "(predicted_frequency_error, from the fidelity report) is above this fraction; 0: all")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0))
+      ->needs(app->get_option("--enrich"));
   return {app, [o, app] { return runQuery(*o, *app); }};
 }
 

@@ -1,5 +1,6 @@
 #include <chrono>
 #include <future>
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -36,7 +37,8 @@ constexpr double kSelfDistance = 1e-6;
 
 /// An object's data from the database's answer to it; `best`, if given, gets the answer's best match.
 Result<AugmentedObject> augmentFrom(const io::Database& database, const io::QueryOptions& options,
-                                    const SceneObject& object, io::MatchReport* best = nullptr) {
+                                    const SceneObject& object, io::MatchReport* best = nullptr,
+                                    std::optional<double>* predictedError = nullptr) {
   Result<io::QueryResult> result = database.query(object.mesh, options);
   if (!result) return withContext(result.error(), object.name);
   if (result->matches.empty() || !result->physics)
@@ -51,6 +53,7 @@ Result<AugmentedObject> augmentFrom(const io::Database& database, const io::Quer
   augmented.locator = std::move(*locator);
   augmented.locatorFrame = augmented.physics.placement;
   if (best) *best = match;
+  if (predictedError) *predictedError = result->predictedFrequencyError;
   return augmented;
 }
 
@@ -63,16 +66,19 @@ AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions
 }
 
 AugmentFunction learningAugmenter(const io::Database& database, io::Enricher& enricher,
-                                  io::QueryOptions options) {
+                                  io::QueryOptions options, double above) {
   options.adapt = true;
   options.link = true;
-  return [&database, &enricher, options](const SceneObject& object) -> Result<AugmentedObject> {
+  if (above > 0.0) options.fidelity = true;  // the predicted error's evidence
+  return [&database, &enricher, options, above](const SceneObject& object) -> Result<AugmentedObject> {
     io::MatchReport best;
-    Result<AugmentedObject> first = augmentFrom(database, options, object, &best);
+    std::optional<double> predicted;
+    Result<AugmentedObject> first = augmentFrom(database, options, object, &best, &predicted);
     if (!first) return first;
     // Learned already, here or elsewhere in the scene (a copy of it moved): nothing better to come.
     if (best.entry && best.entry->family == volume::Family::kLearned && best.match.distance < kSelfDistance)
       return first;
+    if (above > 0.0 && predicted && *predicted <= above) return first;  // good enough as it is
     const std::shared_future<Result<io::Learned>> learned =
         enricher.submit({object.name, object.name, object.mesh});
     const SceneObject* scene = &object;  // the scene outlives the loop

@@ -9,6 +9,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <shapedb/core/error_model.h>
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
 #include <shapedb/io/database.h>
@@ -379,6 +380,18 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
                                         m.match.distance - m.match.momentTerm, options.fidelityOptions);
     }
     out.times.fidelity = microsecondsSince(t);
+    if (out.physics && options.link && !mesh.vertices.empty()) {
+      const core::Fidelity& f = *out.matches.front().fidelity;
+      core::ErrorEvidence evidence;
+      evidence.meanDeviation = f.meanDeviation;
+      evidence.maxDeviation = f.maxDeviation;
+      evidence.maxMomentError = f.maxMomentError;
+      evidence.descriptorDistance = f.descriptorDistance;
+      evidence.outsideShare =
+          static_cast<double>(out.link.outsideCount) / static_cast<double>(mesh.vertices.size());
+      if (out.correction) evidence.morphTargetDistance = out.correction->morph.meanTargetDistance;
+      out.predictedFrequencyError = core::predictFrequencyError(evidence);
+    }
   }
   out.times.total = microsecondsSince(start);
   return out;

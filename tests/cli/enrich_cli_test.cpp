@@ -86,6 +86,13 @@ TEST(EnrichCli, QueryEnrichAnswersTwiceAndTheSecondAnswerIsTheLearnedEntry) {
   lid.triangles.pop_back();
   test::writeFile(open, test::objText(lid));
 
+  // Predicted to be good enough (a threshold no answer reaches): queried, not learned, and said so.
+  const test::ProcessResult skipped =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), meshes[0], "--enrich", "--enrich-above", "100"});
+  ASSERT_EQ(skipped.exitCode, 0) << skipped.err;
+  EXPECT_NE(skipped.err.find("not learned: predicted error"), std::string::npos) << skipped.err;
+  EXPECT_EQ(learnedEntries(db), 0u);
+
   const test::ProcessResult r =
       test::runProcess(SHAPEDB_CLI, {"query", db.string(), meshes[0], open.string(), "--enrich", "--json"});
   EXPECT_EQ(r.exitCode, 1) << r.err;  // the open mesh
@@ -101,6 +108,7 @@ TEST(EnrichCli, QueryEnrichAnswersTwiceAndTheSecondAnswerIsTheLearnedEntry) {
   EXPECT_EQ(again["matches"][0]["family"], "learned");
   EXPECT_LT(again["matches"][0]["distance"].get<double>(), 1e-9);
   EXPECT_NE(again["physics"]["frequencies_hz"][0], q["physics"]["frequencies_hz"][0]);
+  EXPECT_GT(q["predicted_frequency_error"].get<double>(), 0.0);
 
   // Learned once: the file keeps it, the next query --enrich does not compute it again.
   const test::ProcessResult second =

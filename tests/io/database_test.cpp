@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <shapedb/core/error_model.h>
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
 #include <shapedb/core/primitives.h>
@@ -218,6 +219,16 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     EXPECT_EQ(r->matches[0].match.entry, e.id) << e.name;
     ASSERT_TRUE(r->matches[0].fidelity && r->matches[1].fidelity);
     const core::Fidelity& f = *r->matches[0].fidelity;
+    // The answer's predicted error: the shipped model on the best match's evidence.
+    ASSERT_TRUE(r->predictedFrequencyError) << e.name;
+    core::ErrorEvidence evidence{
+        f.meanDeviation,
+        f.maxDeviation,
+        f.maxMomentError,
+        f.descriptorDistance,
+        static_cast<double>(r->link.outsideCount) / static_cast<double>(query.vertexCount()),
+        std::nullopt};
+    EXPECT_DOUBLE_EQ(*r->predictedFrequencyError, core::predictFrequencyError(evidence)) << e.name;
     const bool sampled = turnsSampled(*surface);
     EXPECT_LT(f.descriptorDistance, sampled ? 1e-2 : 1e-6) << e.name;
     EXPECT_LT(f.maxMomentError, 1e-6) << e.name;
@@ -247,6 +258,7 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     corrected.fidelity = false;
     auto c = db->query(query, corrected);
     ASSERT_TRUE(c.ok() && c->physics && c->correction) << e.name;
+    EXPECT_FALSE(c->predictedFrequencyError) << "no fidelity report, no evidence";
     EXPECT_TRUE(c->physics->warnings.empty()) << e.name << ": " << c->physics->warnings.front();
     EXPECT_LT(c->correction->morph.maxBoundaryMove, 1e-9) << e.name;
     EXPECT_LT(c->correction->morph.meanTargetDistance, 1e-9) << e.name;

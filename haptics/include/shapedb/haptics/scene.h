@@ -34,7 +34,9 @@ AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions
 /// object whose first match is a learned entry at a distance of round-off (itself, or a copy of it
 /// elsewhere in the scene, learned before) gets no upgrade. The database, the enricher and the scene's
 /// objects must outlive the loop.
+/// `above` > 0: only objects whose answer's predicted first-frequency error (QueryResult::
+/// predictedFrequencyError; the fidelity report is then computed) is above it are learned.
 AugmentFunction learningAugmenter(const io::Database& database, io::Enricher& enricher,
-                                  io::QueryOptions options);
+                                  io::QueryOptions options, double above = 0.0);
 
 }  // namespace shapedb::haptics

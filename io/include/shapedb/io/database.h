@@ -85,7 +85,11 @@ struct QueryResult {
   /// With adapt: the best match's data (or, corrected, the data of its tets morphed onto the query) in the
   /// query's frame, size and material.
   std::optional<core::AdaptedPhysics> physics;
-  core::SurfaceLink link;                 ///< with QueryOptions::link
+  core::SurfaceLink link;  ///< with QueryOptions::link
+  /// With fidelity, adapt and link: how wrong the answer's first non-rigid frequency probably is
+  /// (core/error_model.h; 0.1 is 10 %), from the best match's fidelity report, the share of the query's
+  /// vertices outside its tets and, corrected, the morph's remaining distance.
+  std::optional<double> predictedFrequencyError;
   std::size_t orientationCandidates = 0;  ///< descriptors searched (orientations)
   QueryTimes times;
 };
