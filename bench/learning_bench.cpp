@@ -2,7 +2,7 @@
 // proxy sweeps the row, and each object it comes near is augmented from the database and, with learning
 // on, learned in the background and swapped to its exact data once they are there.
 //
-//   build/release/bin/learning_bench DB MESH_FOLDER TRUTH_CSV... [--seconds S] [--speed M_PER_S]
+//   build/release/bin/learning_bench DB MESH_FOLDER TRUTH_CSV... [--seconds S]   (default 120)
 //
 // DB is copied (the original is left as it was). TRUTH_CSV are `shapedb bench` results (evaluation.csv)
 // holding the meshes' direct computations (f1_truth_hz per shape, steel): the errors below are against
@@ -89,21 +89,18 @@ std::string percent(double x) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> positional;
-  double seconds = 120.0, speed = 0.05;
+  double seconds = 120.0;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc)
       seconds = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--speed") && i + 1 < argc)
-      speed = std::atof(argv[++i]);
     else if (argv[i][0] == '-') {
       std::fprintf(stderr, "learning_bench: unknown option %s\n", argv[i]);
       return 2;
     } else
       positional.push_back(argv[i]);
   }
-  if (positional.size() < 3 || seconds <= 0.0 || speed <= 0.0) {
-    std::fprintf(stderr,
-                 "usage: learning_bench DB MESH_FOLDER TRUTH_CSV... [--seconds S] [--speed M_PER_S]\n");
+  if (positional.size() < 3 || seconds <= 0.0) {
+    std::fprintf(stderr, "usage: learning_bench DB MESH_FOLDER TRUTH_CSV... [--seconds S]\n");
     return 2;
   }
   const fs::path work = fs::temp_directory_path() / "shapedb-learning-bench.db";
@@ -112,7 +109,7 @@ int main(int argc, char** argv) {
   const std::map<std::string, double> truth =
       readTruth(std::vector<std::string>(positional.begin() + 2, positional.end()));
 
-  // The meshes with a truth, each twice in a row along x, 1.5 of the largest mesh apart: the proxy meets
+  // The meshes with a truth, each twice in a row along x (below): the proxy meets
   // every first appearance before any second.
   auto files = io::listMeshFiles(positional[1]);
   if (!files) {
@@ -120,39 +117,39 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::vector<std::pair<std::string, shapedb::core::TriangleMesh>> meshes;
-  double largest = 0.0;
   for (const fs::path& file : *files) {
-    if (!truth.count(file.filename().string())) continue;
+    if (!truth.count(file.stem().string())) continue;
     auto loaded = io::loadMesh(file);
     if (!loaded) continue;
-    const shapedb::core::Bounds b = shapedb::core::computeBounds(loaded->mesh);
-    largest = std::max(largest, (b.max - b.min).norm());
-    meshes.emplace_back(file.filename().string(), std::move(loaded->mesh));
+    meshes.emplace_back(file.stem().string(), std::move(loaded->mesh));
   }
   if (meshes.empty()) {
     std::fprintf(stderr, "learning_bench: no mesh of %s has a truth in the CSVs\n", positional[1].c_str());
     return 1;
   }
-  const double spacing = 1.5 * largest;
+  // In the scene every mesh is scaled to 10 cm across (the learned entries are scale-free: the queries
+  // below, on the meshes as read, find them all the same), 15 cm apart, and the proxy crosses the row once
+  // in the run: every first appearance in its first half, every second in its second.
+  const double spacing = 0.15;
   std::vector<haptics::SceneObject> objects;
   for (int copy = 0; copy < 2; ++copy)
     for (const auto& [name, mesh] : meshes) {
       haptics::SceneObject o{name + (copy == 0 ? "" : " (again)"), mesh};
       const shapedb::core::Bounds b = shapedb::core::computeBounds(o.mesh);
-      const Vec3 shift =
-          Vec3(spacing * static_cast<double>(objects.size()), 0.0, 0.0) - 0.5 * (b.min + b.max);
+      const double scale = 0.1 / (b.max - b.min).norm();
+      const Vec3 at(spacing * static_cast<double>(objects.size()), 0.0, 0.0);
       for (Vec3& v : o.mesh.vertices)
-        v += shift;
+        v = at + scale * (v - 0.5 * (b.min + b.max));
       objects.push_back(std::move(o));
     }
   const double length = spacing * static_cast<double>(objects.size());
-  const double sweepSeconds = std::max(seconds, length / speed);
+  const double sweepSeconds = seconds;
   auto device = [&] {
     return *haptics::TrajectoryDevice::fromKeyframes(
         {{0.0, Vec3(-spacing, 0.0, 0.0)}, {sweepSeconds, Vec3(length, 0.0, 0.0)}});
   };
   haptics::LoopOptions options;
-  options.augmentationRadius = 0.25 * spacing;
+  options.augmentationRadius = 0.03;
   io::QueryOptions query;
   query.fidelity = false;
 
