@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <deque>
+#include <exception>
 #include <mutex>
 #include <thread>
 #include <unordered_map>
@@ -100,7 +101,7 @@ void Enricher::Impl::work() {
 
 void Enricher::Impl::run(Job& job) {
   const std::string where = job.mesh.source.empty() ? job.mesh.name : job.mesh.source;
-  Result<Learned> result = [&]() -> Result<Learned> {
+  const auto compute = [&]() -> Result<Learned> {
     const core::TriangleMesh* surface = &job.mesh.mesh;
     core::TriangleMesh simplified;
     if (options.maxTriangles > 0 && surface->triangleCount() > options.maxTriangles) {
@@ -125,7 +126,14 @@ void Enricher::Impl::run(Job& job) {
     learned.seconds = std::chrono::duration<double>(Clock::now() - job.submitted).count();
     learned.stages = data->times;
     return learned;
-  }();
+  };
+  // A worker thread must not end the process: what escapes the computation (memory, say) is its error.
+  Result<Learned> result = Error{ErrorCode::kInvalidArgument, where + ": not learned"};
+  try {
+    result = compute();
+  } catch (const std::exception& e) {
+    result = Error{ErrorCode::kInvalidArgument, where + ": learning it threw: " + e.what()};
+  }
   // The books first, then the answer: whoever sees the answer and submits again finds the entry in the
   // database (or the failure remembered), not a computation that looks as if it were still running.
   {
