@@ -24,7 +24,7 @@ std::vector<std::string> writeBlobs(const test::ScratchDir& dir, int count) {
   for (int i = 0; i < count; ++i) {
     const auto path = dir / ("blob" + std::to_string(i) + ".obj");
     test::writeFile(
-        path, test::objText(test::makeLopsidedBlob(core::Vec3(1.0, 0.9 - 0.08 * i, 0.3 + 0.05 * i), 3)));
+        path, test::objText(test::makeLopsidedBlob(core::Vec3(1.0, 0.9 - 0.08 * i, 0.3 + 0.05 * i), 2)));
     files.push_back(path.string());
   }
   return files;

@@ -44,7 +44,7 @@ Database::OpenOptions learning() {
 }
 
 NamedMesh blob(double a, double b, double c, const std::string& name) {
-  return {name, name + ".obj", test::makeLopsidedBlob(core::Vec3(a, b, c), 3)};
+  return {name, name + ".obj", test::makeLopsidedBlob(core::Vec3(a, b, c), 2)};
 }
 
 Result<Learned> learnedOf(const std::shared_future<Result<Learned>>& future) {
