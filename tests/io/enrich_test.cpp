@@ -195,7 +195,7 @@ TEST(Enrich, QueriesBesideLearningAnswerFromReadableEntries) {
   auto db = Database::open(path, learning());
   ASSERT_TRUE(db.ok()) << db.error().message;
   std::vector<NamedMesh> objects;
-  for (int i = 0; i < 3; ++i)
+  for (int i = 0; i < 2; ++i)
     objects.push_back(blob(1.0, 0.8 - 0.15 * i, 0.3 + 0.1 * i, "rock" + std::to_string(i)));
   std::atomic<bool> learning{true};
   std::atomic<int> queries{0}, failures{0}, sawLearned{0};
