@@ -183,8 +183,9 @@ Result<core::EntryId> Database::learn(const std::string& name, const std::string
   if (entry(name) != nullptr)
     return Error{ErrorCode::kInvalidArgument,
                  s.store.path().string() + ": already holds an entry '" + name + "'"};
+  const core::EntryId id = s.nextId;
   EntryRecord r;
-  r.id = s.nextId;
+  r.id = id;
   r.name = name;
   r.family = volume::Family::kLearned;
   r.source = source;
@@ -203,7 +204,6 @@ Result<core::EntryId> Database::learn(const std::string& name, const std::string
     s.learnedByName.emplace(stored.name, &stored);
   }
   // The record first, then the descriptors: a search that finds the entry finds its record too.
-  const core::EntryId id = s.nextId - 1;
   for (std::size_t k = 0; k < s.indexes.size(); ++k) {
     const std::pair<core::EntryId, core::Descriptor> added(id, data.descriptors[k]);
     if (Status st = s.indexes[k]->add(std::span(&added, 1)); !st)
