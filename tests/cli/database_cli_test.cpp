@@ -1,9 +1,7 @@
 // The database subcommands as a user runs them: the real executable, a real file, a real SIGKILL.
 
-#include <chrono>
 #include <signal.h>
 #include <sys/wait.h>
-#include <thread>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -87,10 +85,7 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
   argv.insert(argv.end(), args.begin(), args.end());
   test::RunningProcess build(SHAPEDB_CLI, argv);
   ASSERT_TRUE(build.started());
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  std::size_t before = 0;
-  while ((before = committedEntries(killed)) < 6 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  test::waitUntil([&] { return committedEntries(killed) >= 6; }, 120.0);
   ASSERT_TRUE(build.kill()) << "the build finished before it was killed";
   const std::size_t atKill = committedEntries(killed);
   std::printf("killed with %zu of 24 entries committed\n", atKill);

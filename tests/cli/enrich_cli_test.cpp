@@ -1,7 +1,5 @@
 // shapedb enrich and query --enrich, run as the real executable.
-#include <chrono>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -52,9 +50,7 @@ TEST(EnrichCli, KilledMidEnrichmentKeepsWhatItCommittedAndTheRerunComputesOnlyTh
   {
     test::RunningProcess enrich(SHAPEDB_CLI, args);
     ASSERT_TRUE(enrich.started());
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (learnedEntries(db) < 2 && std::chrono::steady_clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    test::waitUntil([&] { return learnedEntries(db) >= 2; }, 120.0);
     ASSERT_TRUE(enrich.kill()) << "the enrichment finished before it was killed";
   }
   const std::size_t atKill = learnedEntries(db);

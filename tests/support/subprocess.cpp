@@ -88,6 +88,15 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   return result;
 }
 
+bool waitUntil(const std::function<bool()>& condition, double timeoutSeconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutSeconds);
+  for (;;) {
+    if (condition()) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 RunningProcess::RunningProcess(const std::string& program, const std::vector<std::string>& args) {
   std::vector<std::string> owned = {program};
   owned.insert(owned.end(), args.begin(), args.end());

@@ -3,6 +3,7 @@
 // Runs a real executable as a child process and captures what it prints, for end-to-end tests.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ inline constexpr int kSetupFailedExit = 125;
 /// Runs `program` with `args` (no shell), waits for it, and returns its exit code and output.
 ProcessResult runProcess(const std::string& program, const std::vector<std::string>& args,
                          const RunOptions& options = {});
+
+/// Polls `condition` every 20 ms until it holds (true) or `timeoutSeconds` have passed (false): for a test
+/// that waits for a child to reach a point in its work.
+bool waitUntil(const std::function<bool()>& condition, double timeoutSeconds);
 
 /// A child started and left running, for tests that kill it in the middle of its work: its output goes
 /// to /dev/null. Killed (SIGKILL) and reaped when destroyed, if it still runs.
