@@ -365,6 +365,64 @@ TEST_F(SmallDatabase, ConcurrentQueriesAgreeWithSerialOnes) {
   EXPECT_EQ(mismatches.load(), 0);
 }
 
+// A burst (queryMany) against the oracle of one query at a time: every entry's surface under a random
+// similarity, in a shuffled order, some twice, with an open surface among them (its error in its own slot),
+// through a cache smaller than the burst so that the tasks miss and fill it concurrently.
+TEST_F(SmallDatabase, ABurstIsAnsweredInInputOrderExactlyAsEachMeshAlone) {
+  Database::OpenOptions small;
+  small.cacheEntries = 4;
+  auto db = Database::open(sPath, small);
+  ASSERT_TRUE(db.ok());
+  std::mt19937_64 rng(11);
+  std::vector<core::TriangleMesh> burst;
+  for (const EntryRecord& e : db->entries()) {
+    const volume::ShapeSpec spec = volume::familySpec(
+        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    burst.push_back(core::transformed(*volume::makeFamilyShape(spec, db->parameters().resolution),
+                                      test::randomSimilarity(rng, 3.0, 0.5, 2.0)));
+  }
+  std::shuffle(burst.begin(), burst.end(), rng);
+  for (std::size_t i = 0; i < 4; ++i)
+    burst.push_back(burst[i]);
+  core::TriangleMesh open = burst[2];
+  open.triangles.pop_back();
+  burst.insert(burst.begin() + 5, open);
+
+  QueryOptions options;
+  options.search.k = 3;
+  const std::vector<Result<QueryResult>> many = db->queryMany(burst, options);
+  ASSERT_EQ(many.size(), burst.size());
+  for (std::size_t i = 0; i < burst.size(); ++i) {
+    SCOPED_TRACE("mesh " + std::to_string(i));
+    const Result<QueryResult> alone = db->query(burst[i], options);
+    ASSERT_EQ(many[i].ok(), alone.ok());
+    if (!alone.ok()) {
+      EXPECT_EQ(many[i].error().message, alone.error().message);
+      continue;
+    }
+    const QueryResult &a = *alone, &b = *many[i];
+    ASSERT_EQ(b.matches.size(), a.matches.size());
+    for (std::size_t m = 0; m < a.matches.size(); ++m) {
+      EXPECT_EQ(b.matches[m].match.entry, a.matches[m].match.entry);
+      EXPECT_EQ(b.matches[m].match.distance, a.matches[m].match.distance);
+      EXPECT_EQ(b.matches[m].match.orientation, a.matches[m].match.orientation);
+      ASSERT_TRUE(a.matches[m].fidelity && b.matches[m].fidelity);
+      EXPECT_EQ(b.matches[m].fidelity->meanDeviation, a.matches[m].fidelity->meanDeviation);
+    }
+    ASSERT_TRUE(a.physics && b.physics);
+    EXPECT_EQ(b.physics->frequenciesHz(), a.physics->frequenciesHz());
+    EXPECT_EQ(b.physics->tetMesh.nodes, a.physics->tetMesh.nodes);
+    ASSERT_EQ(b.link.locations.size(), a.link.locations.size());
+    for (std::size_t v = 0; v < a.link.locations.size(); ++v) {
+      EXPECT_EQ(b.link.locations[v].tet, a.link.locations[v].tet);
+      EXPECT_EQ(b.link.locations[v].weights, a.link.locations[v].weights);
+    }
+    EXPECT_EQ(b.predictedFrequencyError, a.predictedFrequencyError);
+  }
+  EXPECT_FALSE(many[5].ok());
+  EXPECT_TRUE(db->queryMany({}, options).empty());
+}
+
 TEST(BuildParametersJson, ElementOrderRoundTripsAndOlderFilesAreLinear) {
   BuildParameters quadratic;
   quadratic.families = {volume::Family::kBox};

@@ -154,6 +154,14 @@ class Database {
   /// Errors: the mesh's (validateMesh, computeMassProperties: open or degenerate surfaces), the
   /// material's, Store::physics's.
   Result<QueryResult> query(const core::TriangleMesh& mesh, const QueryOptions& options = {}) const;
+
+  /// A burst of queries at one instant (the fragments of a fracture, the files of one `shapedb query`):
+  /// every mesh answered exactly as query() answers it alone, the meshes spread over the machine's cores
+  /// (TBB, one task per mesh; each query's own parallel stages share the same workers), the results in
+  /// input order. A mesh that fails has its error in its own slot and the others go on. Thread-safe as
+  /// query() is; each result's times are its own query's wall times, overlapping the others'.
+  std::vector<Result<QueryResult>> queryMany(std::span<const core::TriangleMesh> meshes,
+                                             const QueryOptions& options = {}) const;
   /// One entry's physical data, from the cache or the file. Errors: Store::physics's.
   Result<std::shared_ptr<const core::PhysicalData>> physics(core::EntryId id) const;
   /// One entry's point locator (its tets and their boundary), built once per cached entry.
