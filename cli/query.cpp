@@ -273,10 +273,10 @@ nlohmann::json answerJson(const io::QueryResult& r) {
 }
 
 nlohmann::json queryJson(const std::string& file, const io::LoadedMesh& loaded,
-                         const std::optional<volume::RepairReport>& repaired, const io::QueryResult& r,
-                         const std::string& descriptor) {
+                         const core::TriangleMesh& mesh, const std::optional<volume::RepairReport>& repaired,
+                         const io::QueryResult& r, const std::string& descriptor) {
   nlohmann::json q = {{"file", file},
-                      {"triangles", loaded.mesh.triangleCount()},
+                      {"triangles", mesh.triangleCount()},
                       {"scale", loaded.scale},
                       {"flipped_inside_out", loaded.flippedInsideOut},
                       {"welded_vertices", loaded.verticesWelded},
@@ -296,6 +296,14 @@ nlohmann::json queryJson(const std::string& file, const io::LoadedMesh& loaded,
   q.update(answerJson(r));
   return q;
 }
+
+/// A query's file as read, its mesh moved out into the batch that queryMany answers.
+struct LoadedFile {
+  std::size_t index = 0;  ///< among the command's files
+  std::string file;
+  io::LoadedMesh loaded;
+  std::optional<volume::RepairReport> repaired;
+};
 
 /// A mesh handed to the enricher by query --enrich: answered again once it is learned.
 struct PendingLearn {
@@ -381,47 +389,65 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   nlohmann::json queries = nlohmann::json::array();
   int status = kExitOk;
   if (o.table && !o.json) printTableHeader();
-  for (std::size_t i = 0; i < o.meshes.size(); ++i) {
-    const std::string& file = o.meshes[i];
-    std::optional<volume::RepairReport> repaired;
-    auto loaded = loadMeshFile(file, o.load, &repaired);
-    if (!loaded) {
-      printError(loaded.error().message + flagHint(loaded.error()));
-      status = kExitInputError;
-      continue;
-    }
-    auto result = db->query(loaded->mesh, options);
-    if (!result) {
-      printError(file + ": " + result.error().message + flagHint(result.error()));
-      status = kExitInputError;
-      continue;
-    }
-    // Learned unless its answer is predicted to be good enough already (--enrich-above).
-    const bool learn = enricher && (o.enrichAbove <= 0.0 || !result->predictedFrequencyError ||
-                                    *result->predictedFrequencyError > o.enrichAbove);
-    if (learn)
-      pending.push_back(
-          {file, loaded->mesh, queries.size(),
-           enricher->submit({std::filesystem::path(file).filename().string(), file, loaded->mesh})});
-    else if (enricher && !o.json)
-      std::fprintf(stderr, "shapedb: %s: not learned: predicted error %.1f %% is within --enrich-above\n",
-                   file.c_str(), 100.0 * *result->predictedFrequencyError);
-    if (!o.exportDir.empty())
-      if (Status st = exportObj(o.exportDir, std::filesystem::path(file).stem().string(), *result); !st) {
-        printError(st.error().message);
-        return kExitInputError;
+  // The files are loaded and answered a batch at a time (Database::queryMany spreads a batch's queries
+  // over the cores) and printed in the order given. A batch holds up to 256 files or 4 million
+  // triangles, so that a folder of large scans is never in memory all at once.
+  constexpr std::size_t kBatchFiles = 256, kBatchTriangles = 4'000'000;
+  for (std::size_t next = 0; next < o.meshes.size();) {
+    std::vector<LoadedFile> batch;
+    std::vector<core::TriangleMesh> meshes;  // batch[b]'s mesh is meshes[b] (moved out of its LoadedMesh)
+    std::size_t triangles = 0;
+    while (next < o.meshes.size() && batch.size() < kBatchFiles && triangles < kBatchTriangles) {
+      LoadedFile f{next, o.meshes[next], {}, {}};
+      ++next;
+      auto loaded = loadMeshFile(f.file, o.load, &f.repaired);
+      if (!loaded) {
+        printError(loaded.error().message + flagHint(loaded.error()));
+        status = kExitInputError;
+        continue;
       }
-    if (!o.png.empty())
-      if (Status st = renderPng(pngPath(o.png, i, o.meshes.size()), loaded->mesh, *result); !st) {
-        printError(st.error().message);
-        return kExitInputError;
+      triangles += loaded->mesh.triangleCount();
+      meshes.push_back(std::move(loaded->mesh));
+      f.loaded = std::move(loaded).value();
+      batch.push_back(std::move(f));
+    }
+    const std::vector<Result<io::QueryResult>> results = db->queryMany(meshes, options);
+    for (std::size_t b = 0; b < batch.size(); ++b) {
+      const LoadedFile& f = batch[b];
+      const core::TriangleMesh& mesh = meshes[b];
+      const Result<io::QueryResult>& result = results[b];
+      if (!result) {
+        printError(f.file + ": " + result.error().message + flagHint(result.error()));
+        status = kExitInputError;
+        continue;
       }
-    if (o.json)
-      queries.push_back(queryJson(file, *loaded, repaired, *result, o.descriptor));
-    else if (o.table)
-      printTableRow(file, *result);
-    else
-      printText(file, loaded->mesh, *result, o.timing);
+      // Learned unless its answer is predicted to be good enough already (--enrich-above).
+      const bool learn = enricher && (o.enrichAbove <= 0.0 || !result->predictedFrequencyError ||
+                                      *result->predictedFrequencyError > o.enrichAbove);
+      if (learn)
+        pending.push_back(
+            {f.file, mesh, queries.size(),
+             enricher->submit({std::filesystem::path(f.file).filename().string(), f.file, mesh})});
+      else if (enricher && !o.json)
+        std::fprintf(stderr, "shapedb: %s: not learned: predicted error %.1f %% is within --enrich-above\n",
+                     f.file.c_str(), 100.0 * *result->predictedFrequencyError);
+      if (!o.exportDir.empty())
+        if (Status st = exportObj(o.exportDir, std::filesystem::path(f.file).stem().string(), *result); !st) {
+          printError(st.error().message);
+          return kExitInputError;
+        }
+      if (!o.png.empty())
+        if (Status st = renderPng(pngPath(o.png, f.index, o.meshes.size()), mesh, *result); !st) {
+          printError(st.error().message);
+          return kExitInputError;
+        }
+      if (o.json)
+        queries.push_back(queryJson(f.file, f.loaded, mesh, f.repaired, *result, o.descriptor));
+      else if (o.table)
+        printTableRow(f.file, *result);
+      else
+        printText(f.file, mesh, *result, o.timing);
+    }
   }
   if (enricher)
     if (answerAgain(o, *db, options, pending, queries) != kExitOk) status = kExitInputError;
@@ -440,7 +466,9 @@ Command addQueryCommand(CLI::App& parent) {
       "(paper Algorithm 1): the entry's tet mesh, modes, collision compound and mass properties carried to\n"
       "the mesh's frame and size and scaled to a material; the mesh's vertices linked to the tets; and a\n"
       "fidelity report per match (principal moments and surface deviation against the mesh, relative).\n"
-      "Meshes must be closed and consistently oriented. Exit status 1 if any mesh failed.");
+      "Meshes must be closed and consistently oriented. Many meshes (the fragments of a fracture, say) are\n"
+      "answered together, spread over the machine's cores, and printed in the order given. Exit status 1\n"
+      "if any mesh failed.");
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
   app->add_option("MESH", o->meshes, "Query surface meshes (.obj, .ply, .off, .stl)")->required();
   addMeshLoadFlags(*app, o->load);
