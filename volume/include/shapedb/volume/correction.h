@@ -23,6 +23,9 @@ struct CorrectionReport {
   /// the target; above 1 where held-back boundary nodes cut corners).
   double volumeScale = 1.0;
   int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
+  /// Entries morphed to choose this one from (a query's candidates, io::QueryOptions::correctionCandidates);
+  /// morphSeconds is all of their morphs'.
+  int morphs = 1;
   double morphSeconds = 0.0;
   double modesSeconds = 0.0;
 };
@@ -36,10 +39,29 @@ struct CorrectedEntry {
   CorrectionReport report;
 };
 
+/// The correction's first half: `entry`'s tets morphed onto `target` and scaled to its volume; report has
+/// the morph, the volume scale and morphSeconds. How well the result reaches the target
+/// (report.morph.meanTargetDistance) is known here, before the modes cost anything: a query chooses among
+/// its best matches by it.
+struct MorphedEntry {
+  core::TetMesh tetMesh;
+  CorrectionReport report;
+};
+
 /// Morphs `entry`'s tets onto `target` (the query's surface carried into the entry's canonical frame:
-/// unit volume, the entry's axes, core::Placement::toEntry) and computes their modes with `modal` (the
-/// database's: count, elements, Poisson ratio; E = ρ = 1), seeded by the entry's modes. Thread-safe.
-/// Errors: morphTetMesh's (the morph would invert a tet: keep the entry's data), computeModesFrom's.
+/// unit volume, the entry's axes, core::Placement::toEntry) and scales them about their centre of mass to
+/// its volume. Thread-safe. Errors: kInvalidArgument (the entry's modes do not fit its tets), morphTetMesh's
+/// (the morph would invert a tet: keep the entry's data).
+Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::TriangleMesh& target,
+                                const CorrectionOptions& options = {});
+
+/// The correction's second half: the modes of `morphed` (morphEntry of this `entry`) computed with `modal`
+/// (the database's: count, elements, Poisson ratio; E = ρ = 1), seeded by the entry's modes; the entry's
+/// collision compound and damping. Thread-safe. Errors: computeModesFrom's.
+Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEntry morphed,
+                                      const ModalOptions& modal);
+
+/// Both halves: morphEntry, then correctMorphed.
 Result<CorrectedEntry> correctGeometry(const core::PhysicalData& entry, const core::TriangleMesh& target,
                                        const ModalOptions& modal, const CorrectionOptions& options = {});
 
