@@ -40,6 +40,7 @@ struct QueryCommandOptions {
   bool noFidelity = false;
   bool stretch = false;
   bool correct = false;
+  int correctCandidates = io::QueryOptions{}.correctionCandidates;
   bool table = false;
   bool enrich = false;
   double enrichAbove = 0.0;
@@ -108,6 +109,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mean_target_distance", c.morph.meanTargetDistance},
           {"projected", c.morph.projected},
           {"volume_scale", c.volumeScale},
+          {"morphs", c.morphs},
           {"solves", c.solves},
           {"morph_seconds", c.morphSeconds},
           {"modes_seconds", c.modesSeconds}};
@@ -166,6 +168,9 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
           "    modes of the entry stretched by %.3f, %.3f, %.3f along its axes (to the mesh's proportions)\n",
           p.stretch.x(), p.stretch.y(), p.stretch.z());
     if (r.correction) {
+      if (r.correction->morphs > 1)
+        std::printf("    corrected from rank %zu: of the %d best matches' morphs, the one nearest the mesh\n",
+                    r.answered + 1, r.correction->morphs);
       const volume::MorphReport& m = r.correction->morph;
       std::printf(
           "    corrected: the entry's tets morphed onto the mesh (boundary moved up to %.3g L, worst tet "
@@ -236,7 +241,7 @@ void printTableHeader() {
 }
 
 void printTableRow(const std::string& file, const io::QueryResult& r) {
-  const io::MatchReport& m = r.matches.front();
+  const io::MatchReport& m = r.answeredMatch();
   std::printf("%-24s %-24s %9.4f", std::filesystem::path(file).filename().string().c_str(),
               m.entry ? m.entry->name.c_str() : "?", m.match.distance);
   if (m.fidelity)
@@ -261,8 +266,9 @@ nlohmann::json answerJson(const io::QueryResult& r) {
   nlohmann::json q = {{"matches", nlohmann::json::array()}, {"timing_us", timingJson(r.times)}};
   for (const io::MatchReport& m : r.matches)
     q["matches"].push_back(matchJson(m));
-  if (!r.matches.empty() && r.matches.front().fidelity)
-    q["fidelity"] = matchJson(r.matches.front())["fidelity"];
+  if (!r.matches.empty() && r.answeredMatch().fidelity)
+    q["fidelity"] = matchJson(r.answeredMatch())["fidelity"];
+  if (!r.matches.empty()) q["answered"] = r.answered;
   if (r.physics) q["physics"] = physicsJson(*r.physics);
   if (r.correction) q["correction"] = correctionJson(*r.correction);
   if (r.predictedFrequencyError) q["predicted_frequency_error"] = *r.predictedFrequencyError;
@@ -363,6 +369,7 @@ io::QueryOptions queryOptionsOf(const QueryCommandOptions& o) {
   options.fidelity = !o.noFidelity;
   options.stretchCorrection = o.stretch;
   options.correct = o.correct;
+  options.correctionCandidates = o.correctCandidates;
   return options;
 }
 
@@ -507,11 +514,18 @@ Command addQueryCommand(CLI::App& parent) {
                 "docs/architecture.md)");
   app->add_flag(
          "--correct", o->correct,
-         "Geometry correction: morph the best entry's tets onto the mesh's own surface and compute\n"
-         "their modes again there, so that the data have the mesh's proportions and thin parts, not\n"
-         "the entry's (tens of ms per query; where the morph would invert a tet, the entry's own data\n"
-         "stand, with a warning). JSON gains \"correction\": the morph's quality and cost")
+         "Geometry correction: morph the best entries' tets onto the mesh's own surface (see\n"
+         "--correct-candidates), and compute the modes again on the morph that reaches the surface\n"
+         "best, so that the data have the mesh's proportions and thin parts, not the entry's (tens to\n"
+         "hundreds of ms per query; where no morph keeps every tet positive, the best entry's own data\n"
+         "stand, with a warning). JSON gains \"correction\": the morph's quality and cost, and\n"
+         "\"answered\": the rank (from 0) of the match whose data the answer carries")
       ->excludes(app->get_option("--stretch"));
+  app->add_option("--correct-candidates", o->correctCandidates,
+                  "With --correct: how many of the best matches are morphed to choose from (the search\n"
+                  "finds at least as many; each costs one morph, a fraction of the modes' cost)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
   app->add_flag("--enrich", o->enrich,
                 "Learn each mesh too: compute its exact data in the background (the database's own\n"
                 "pipeline, seconds a mesh, on all cores), add them to DB as a 'learned' entry (DB must be\n"

@@ -97,7 +97,7 @@ int runSound(const SoundCommandOptions& o, const CLI::App& app) {
   }
   const core::Vec3& p = mesh.vertices[vertex];
   std::printf("%s: matched %s; %s; struck at vertex %zu (%.4g, %.4g, %.4g) m\n", o.mesh.c_str(),
-              r->matches.front().entry->name.c_str(), material->name.c_str(), vertex, p.x(), p.y(), p.z());
+              r->answeredMatch().entry->name.c_str(), material->name.c_str(), vertex, p.x(), p.y(), p.z());
   std::printf("%zu of %lld modes ring:", sound->modes.size(),
               static_cast<long long>(r->physics->eigenvalues.size()));
   for (Eigen::Index i = 0; i < sound->frequenciesHz.size(); ++i)

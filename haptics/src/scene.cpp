@@ -43,7 +43,7 @@ Result<AugmentedObject> augmentFrom(const io::Database& database, const io::Quer
   if (!result) return withContext(result.error(), object.name);
   if (result->matches.empty() || !result->physics)
     return Error{ErrorCode::kInvalidArgument, object.name + ": the database gave no match"};
-  const io::MatchReport& match = result->matches.front();
+  const io::MatchReport& match = result->answeredMatch();
   Result<std::shared_ptr<const core::TetLocator>> locator = database.locator(match.match.entry);
   if (!locator) return withContext(locator.error(), object.name);
   AugmentedObject augmented;

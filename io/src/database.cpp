@@ -281,6 +281,9 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     return Error{ErrorCode::kInvalidArgument,
                  "the stretch correction needs a database of linear tets; " + mImpl->store.path().string() +
                      " has quadratic ones (its stretch basis would need their mid-edge values)"};
+  const bool correcting = options.adapt && options.correct;
+  if (correcting && (options.correctionCandidates < 1 || options.correctionCandidates > 100))
+    return Error{ErrorCode::kInvalidArgument, "the geometry correction's candidates must be 1 to 100"};
 
   Clock::time_point t = Clock::now();
   if (Status valid = core::validateMesh(mesh); !valid) return valid.error();
@@ -304,7 +307,9 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   out.times.describe = microsecondsSince(t);
 
   t = Clock::now();
-  auto matches = index(options.descriptor).search(*candidates, options.search);
+  core::SearchOptions search = options.search;
+  if (correcting) search.k = std::max(search.k, options.correctionCandidates);
+  auto matches = index(options.descriptor).search(*candidates, search);
   if (!matches) return matches.error();
   out.times.search = microsecondsSince(t);
   for (const core::Match& m : *matches)
@@ -316,50 +321,76 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
 
   t = Clock::now();
   std::vector<std::shared_ptr<const CachedEntry>> entries;
-  const std::size_t fetchCount = options.fidelity ? out.matches.size() : 1;
+  const std::size_t candidateCount =
+      correcting ? std::min(out.matches.size(), static_cast<std::size_t>(options.correctionCandidates)) : 1;
+  const std::size_t fetchCount = options.fidelity ? out.matches.size() : candidateCount;
   for (std::size_t i = 0; i < fetchCount; ++i) {
     auto e = mImpl->cachedEntry(out.matches[i].match.entry);
     if (!e) return e.error();
     entries.push_back(std::move(e).value());
   }
   out.times.fetch = microsecondsSince(t);
-  const CachedEntry& best = *entries.front();
-  out.entryPhysics = std::shared_ptr<const core::PhysicalData>(entries.front(), &best.data);
+  out.entryPhysics = std::shared_ptr<const core::PhysicalData>(entries.front(), &entries.front()->data);
 
   if (options.adapt) {
-    // The geometry correction first, in the entry's canonical frame: the query's surface carried there,
-    // the entry's tets morphed onto it and their modes computed again.
-    const core::Placement placement =
-        core::placementOf(out.normalization, out.matches.front().match.orientation);
+    // The geometry correction first, in the entries' canonical frames: the query's surface carried into
+    // each candidate's, the candidate's tets morphed onto it, and the modes computed again for the one
+    // that reaches the query's surface best.
     std::optional<volume::CorrectedEntry> corrected;
     std::optional<core::TetLocator> correctedLocator;
     std::string correctionWarning;
     if (options.correct) {
       t = Clock::now();
-      core::TriangleMesh target = mesh;
-      for (core::Vec3& p : target.vertices)
-        p = placement.toEntry(p);
-      // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
-      volume::ModalOptions modal = parameters().entry.modal;
-      modal.material.poissonRatio = options.material.poissonRatio;
-      auto c = volume::correctGeometry(best.data, target, modal, options.correction);
-      if (c) {
-        out.correction = c->report;
-        corrected = std::move(c).value();
-        correctedLocator.emplace(corrected->physics.tetMesh);
-      } else {
-        correctionWarning =
-            "geometry correction not applied (the entry's own data stand): " + c.error().message;
+      std::optional<volume::MorphedEntry> chosen;
+      std::string firstError;
+      double morphSeconds = 0.0;
+      for (std::size_t i = 0; i < candidateCount; ++i) {
+        const core::Placement placement =
+            core::placementOf(out.normalization, out.matches[i].match.orientation);
+        core::TriangleMesh target = mesh;
+        for (core::Vec3& p : target.vertices)
+          p = placement.toEntry(p);
+        auto morphed = volume::morphEntry(entries[i]->data, target, options.correction);
+        if (!morphed) {
+          if (firstError.empty()) firstError = morphed.error().message;
+          continue;
+        }
+        morphSeconds += morphed->report.morphSeconds;
+        if (!chosen || morphed->report.morph.meanTargetDistance < chosen->report.morph.meanTargetDistance) {
+          chosen = std::move(morphed).value();
+          out.answered = i;
+        }
+      }
+      if (chosen) {
+        chosen->report.morphs = static_cast<int>(candidateCount);
+        chosen->report.morphSeconds = morphSeconds;
+        // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
+        volume::ModalOptions modal = parameters().entry.modal;
+        modal.material.poissonRatio = options.material.poissonRatio;
+        auto c = volume::correctMorphed(entries[out.answered]->data, std::move(*chosen), modal);
+        if (c) {
+          out.correction = c->report;
+          corrected = std::move(c).value();
+          correctedLocator.emplace(corrected->physics.tetMesh);
+        } else {
+          firstError = c.error().message;
+        }
+      }
+      if (!corrected) {
+        out.answered = 0;
+        correctionWarning = "geometry correction not applied (the entry's own data stand): " + firstError;
       }
       out.times.correct = microsecondsSince(t);
     }
-    const core::PhysicalData& data = corrected ? corrected->physics : best.data;
-    const core::TetLocator& locator = corrected ? *correctedLocator : best.locator;
+    const CachedEntry& answered = *entries[out.answered];
+    out.entryPhysics = std::shared_ptr<const core::PhysicalData>(entries[out.answered], &answered.data);
+    const core::PhysicalData& data = corrected ? corrected->physics : answered.data;
+    const core::TetLocator& locator = corrected ? *correctedLocator : answered.locator;
 
     t = Clock::now();
     auto adapted = core::adapt(
-        data, out.normalization, out.massProperties, out.matches.front().match.orientation, options.material,
-        parameters().entry.damping, options.stretchCorrection ? &best.stretchBasis() : nullptr);
+        data, out.normalization, out.massProperties, out.answeredMatch().match.orientation, options.material,
+        parameters().entry.damping, options.stretchCorrection ? &answered.stretchBasis() : nullptr);
     if (!adapted) return adapted.error();
     out.physics = std::move(adapted).value();
     if (!correctionWarning.empty()) out.physics->warnings.push_back(correctionWarning);
@@ -383,7 +414,7 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     }
     out.times.fidelity = microsecondsSince(t);
     if (out.physics && options.link && !mesh.vertices.empty()) {
-      const core::Fidelity& f = *out.matches.front().fidelity;
+      const core::Fidelity& f = *out.answeredMatch().fidelity;
       core::ErrorEvidence evidence;
       evidence.meanDeviation = f.meanDeviation;
       evidence.maxDeviation = f.maxDeviation;

@@ -220,7 +220,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
       const core::StretchBasis basis =
           core::computeStretchBasis(q.entryPhysics->tetMesh, q.entryPhysics->modes);
       Result<core::AdaptedPhysics> a =
-          core::adapt(*q.entryPhysics, q.normalization, q.massProperties, q.matches.front().match.orientation,
+          core::adapt(*q.entryPhysics, q.normalization, q.massProperties, q.answeredMatch().match.orientation,
                       options.material, entry.damping, &basis);
       stretched[i].micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
       if (!a)
@@ -281,14 +281,14 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
             const QueryResult& q = *queries[i][k];
             MethodEvaluation m;
             m.method = method;
-            m.match = q.matches.front().entry->name;
-            m.family = volume::toString(q.matches.front().entry->family);
-            m.distance = q.matches.front().match.distance;
+            const MatchReport& best = q.answeredMatch();
+            m.match = best.entry->name;
+            m.family = volume::toString(best.entry->family);
+            m.distance = best.match.distance;
             frequencyErrors(m, q.physics->frequenciesHz(), e.truthFrequenciesHz, options.frequencies);
             m.overlap = core::sampleOverlap(shape, core::sampledSolid(q.physics->collision),
                                             options.overlapResolution);
             m.queryMicros = q.times.total - q.times.fidelity;
-            const MatchReport& best = q.matches.front();
             if (best.fidelity) {
               m.meanDeviation = best.fidelity->meanDeviation;
               m.maxDeviation = best.fidelity->maxDeviation;

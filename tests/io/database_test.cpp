@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -363,6 +364,78 @@ TEST_F(SmallDatabase, ConcurrentQueriesAgreeWithSerialOnes) {
   for (auto& t : threads)
     t.join();
   EXPECT_EQ(mismatches.load(), 0);
+}
+
+// The correction's choice among candidates against its oracle: each of the first three matches' entries
+// morphed onto the query on its own (volume::morphEntry); the answer must carry the one nearest the
+// query's surface (the first of equals), with the modes computed on exactly that morph. Queries: entries'
+// own surfaces stretched out of their proportions, so that the candidates' morphs differ.
+TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQueryBest) {
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  const core::Mat3 stretch = core::Vec3(1.3, 0.9, 0.85).asDiagonal();
+  std::size_t checked = 0;
+  for (std::size_t n = 0; n < db->entries().size(); n += 8) {
+    const EntryRecord& e = db->entries()[n];
+    const volume::ShapeSpec spec = volume::familySpec(
+        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    core::TriangleMesh query = *volume::makeFamilyShape(spec, db->parameters().resolution);
+    for (core::Vec3& v : query.vertices)
+      v = stretch * v;
+    QueryOptions options;
+    options.fidelity = false;
+    options.correct = true;
+    options.correctionCandidates = 3;
+    auto r = db->query(query, options);
+    ASSERT_TRUE(r.ok() && r->physics) << e.name << ": " << (r ? "" : r.error().message);
+    ASSERT_GE(r->matches.size(), 3u) << e.name;
+    if (!r->correction) continue;  // no candidate could be morphed: the other test's case
+    ++checked;
+
+    std::optional<volume::MorphedEntry> best;
+    std::size_t bestIndex = 0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const core::Placement placement = core::placementOf(r->normalization, r->matches[i].match.orientation);
+      core::TriangleMesh target = query;
+      for (core::Vec3& v : target.vertices)
+        v = placement.toEntry(v);
+      auto entry = db->physics(r->matches[i].match.entry);
+      ASSERT_TRUE(entry.ok());
+      auto morphed = volume::morphEntry(**entry, target, options.correction);
+      if (morphed &&
+          (!best || morphed->report.morph.meanTargetDistance < best->report.morph.meanTargetDistance)) {
+        best = std::move(morphed).value();
+        bestIndex = i;
+      }
+    }
+    ASSERT_TRUE(best.has_value()) << e.name;
+    EXPECT_EQ(r->answered, bestIndex) << e.name;
+    EXPECT_EQ(r->answeredMatch().match.entry, r->matches[bestIndex].match.entry);
+    EXPECT_EQ(r->correction->morphs, 3) << e.name;
+    EXPECT_EQ(r->correction->morph.meanTargetDistance, best->report.morph.meanTargetDistance) << e.name;
+    EXPECT_EQ(r->entryPhysics->tetMesh.nodes,
+              (*db->physics(r->matches[bestIndex].match.entry))->tetMesh.nodes)
+        << e.name;
+
+    volume::ModalOptions modal = db->parameters().entry.modal;
+    modal.material.poissonRatio = options.material.poissonRatio;
+    auto expected = volume::correctMorphed(*r->entryPhysics, std::move(*best), modal);
+    ASSERT_TRUE(expected.ok()) << e.name << ": " << expected.error().message;
+    auto adapted =
+        core::adapt(expected->physics, r->normalization, r->massProperties,
+                    r->answeredMatch().match.orientation, options.material, db->parameters().entry.damping);
+    ASSERT_TRUE(adapted.ok());
+    EXPECT_EQ(r->physics->frequenciesHz(), adapted->frequenciesHz()) << e.name;
+
+    // One candidate: the best match, whatever the others' morphs.
+    if (checked > 1) continue;
+    options.correctionCandidates = 1;
+    auto one = db->query(query, options);
+    ASSERT_TRUE(one.ok() && one->correction) << e.name;
+    EXPECT_EQ(one->answered, 0u);
+    EXPECT_EQ(one->correction->morphs, 1);
+  }
+  EXPECT_GT(checked, 0u);
 }
 
 // A burst (queryMany) against the oracle of one query at a time: every entry's surface under a random
