@@ -53,8 +53,8 @@ struct QueryOptions {
   /// smallest mean distance from the query's vertices to them) is the one whose modes are computed and
   /// given: the nearest descriptor is not always the shape that morphs best. Each further candidate costs
   /// one morph, a fraction of the modes' cost. On the benchmark, three took the median first-frequency
-  /// error on real meshes from 24 % to 17 % and on fracture fragments from 6 % to 5 % and 4 % to 3 %
-  /// (docs/accuracy.md). 1: the best match only.
+  /// error on real meshes from 24 % to 17 % and on fracture fragments from 5.9 % to 5.3 % and 3.7 % to
+  /// 3.3 % (docs/architecture.md, "Which entry is morphed"). 1: the best match only.
   int correctionCandidates = 3;
   bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
   core::FidelityOptions fidelityOptions;
