@@ -44,13 +44,12 @@ Result<AugmentedObject> augmentFrom(const io::Database& database, const io::Quer
   if (result->matches.empty() || !result->physics)
     return Error{ErrorCode::kInvalidArgument, object.name + ": the database gave no match"};
   const io::MatchReport& match = result->answeredMatch();
-  Result<std::shared_ptr<const core::TetLocator>> locator = database.locator(match.match.entry);
-  if (!locator) return withContext(locator.error(), object.name);
   AugmentedObject augmented;
   augmented.source = match.entry ? match.entry->name : std::to_string(match.match.entry);
   augmented.physics = std::move(*result->physics);
   augmented.link = std::move(result->link);
-  augmented.locator = std::move(*locator);
+  // The answer's own: the corrected tets' where the geometry correction ran, not the entry's.
+  augmented.locator = std::move(result->locator);
   augmented.locatorFrame = augmented.physics.placement;
   if (best) *best = match;
   if (predictedError) *predictedError = result->predictedFrequencyError;

@@ -43,6 +43,54 @@ double microsecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
+/// The geometry correction of a query: the corrected data and the index of the match they are of, or why
+/// there are none.
+struct Correction {
+  std::optional<volume::CorrectedEntry> corrected;
+  std::size_t answered = 0;
+  std::string error;  ///< the first failure's, when nothing was corrected
+};
+
+/// Morphs the entries of `q`'s first `candidates` matches (`entries`, in match order) onto `mesh`, each
+/// carried into its entry's canonical frame, and computes the modes of the morph that reaches `mesh`'s
+/// surface best (the smallest mean target distance; the first of equals). Candidates whose morph fails
+/// are passed over.
+Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryResult& q,
+                                  std::span<const std::shared_ptr<const CachedEntry>> entries,
+                                  std::size_t candidates, const volume::ModalOptions& modal,
+                                  const volume::CorrectionOptions& options) {
+  Correction out;
+  std::optional<volume::MorphedEntry> chosen;
+  double morphSeconds = 0.0;
+  for (std::size_t i = 0; i < candidates; ++i) {
+    const core::Placement placement = core::placementOf(q.normalization, q.matches[i].match.orientation);
+    core::TriangleMesh target = mesh;
+    for (core::Vec3& p : target.vertices)
+      p = placement.toEntry(p);
+    auto morphed = volume::morphEntry(entries[i]->data, target, options);
+    if (!morphed) {
+      if (out.error.empty()) out.error = morphed.error().message;
+      continue;
+    }
+    morphSeconds += morphed->report.morphSeconds;
+    if (!chosen || morphed->report.morph.meanTargetDistance < chosen->report.morph.meanTargetDistance) {
+      chosen = std::move(morphed).value();
+      out.answered = i;
+    }
+  }
+  if (!chosen) return out;
+  chosen->report.morphs = static_cast<int>(candidates);
+  chosen->report.morphSeconds = morphSeconds;
+  auto c = volume::correctMorphed(entries[out.answered]->data, std::move(*chosen), modal);
+  if (!c) {
+    out.error = c.error().message;
+    out.answered = 0;
+    return out;
+  }
+  out.corrected = std::move(c).value();
+  return out;
+}
+
 }  // namespace
 
 /// The writing connection of a Database opened to learn. Left, it leaves the file in rollback-journal
@@ -337,55 +385,31 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     // each candidate's, the candidate's tets morphed onto it, and the modes computed again for the one
     // that reaches the query's surface best.
     std::optional<volume::CorrectedEntry> corrected;
-    std::optional<core::TetLocator> correctedLocator;
+    std::shared_ptr<const core::TetLocator> correctedLocator;
     std::string correctionWarning;
     if (options.correct) {
       t = Clock::now();
-      std::optional<volume::MorphedEntry> chosen;
-      std::string firstError;
-      double morphSeconds = 0.0;
-      for (std::size_t i = 0; i < candidateCount; ++i) {
-        const core::Placement placement =
-            core::placementOf(out.normalization, out.matches[i].match.orientation);
-        core::TriangleMesh target = mesh;
-        for (core::Vec3& p : target.vertices)
-          p = placement.toEntry(p);
-        auto morphed = volume::morphEntry(entries[i]->data, target, options.correction);
-        if (!morphed) {
-          if (firstError.empty()) firstError = morphed.error().message;
-          continue;
-        }
-        morphSeconds += morphed->report.morphSeconds;
-        if (!chosen || morphed->report.morph.meanTargetDistance < chosen->report.morph.meanTargetDistance) {
-          chosen = std::move(morphed).value();
-          out.answered = i;
-        }
-      }
-      if (chosen) {
-        chosen->report.morphs = static_cast<int>(candidateCount);
-        chosen->report.morphSeconds = morphSeconds;
-        // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
-        volume::ModalOptions modal = parameters().entry.modal;
-        modal.material.poissonRatio = options.material.poissonRatio;
-        auto c = volume::correctMorphed(entries[out.answered]->data, std::move(*chosen), modal);
-        if (c) {
-          out.correction = c->report;
-          corrected = std::move(c).value();
-          correctedLocator.emplace(corrected->physics.tetMesh);
-        } else {
-          firstError = c.error().message;
-        }
-      }
-      if (!corrected) {
-        out.answered = 0;
-        correctionWarning = "geometry correction not applied (the entry's own data stand): " + firstError;
+      // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
+      volume::ModalOptions modal = parameters().entry.modal;
+      modal.material.poissonRatio = options.material.poissonRatio;
+      Correction c = correctAmongCandidates(mesh, out, entries, candidateCount, modal, options.correction);
+      if (c.corrected) {
+        out.answered = c.answered;
+        out.correction = c.corrected->report;
+        corrected = std::move(c.corrected);
+        correctedLocator = std::make_shared<const core::TetLocator>(corrected->physics.tetMesh);
+      } else {
+        correctionWarning = "geometry correction not applied (the entry's own data stand): " + c.error;
       }
       out.times.correct = microsecondsSince(t);
     }
     const CachedEntry& answered = *entries[out.answered];
     out.entryPhysics = std::shared_ptr<const core::PhysicalData>(entries[out.answered], &answered.data);
     const core::PhysicalData& data = corrected ? corrected->physics : answered.data;
-    const core::TetLocator& locator = corrected ? *correctedLocator : answered.locator;
+    out.locator = corrected
+                      ? correctedLocator
+                      : std::shared_ptr<const core::TetLocator>(entries[out.answered], &answered.locator);
+    const core::TetLocator& locator = *out.locator;
 
     t = Clock::now();
     auto adapted = core::adapt(

@@ -427,6 +427,20 @@ TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQu
     ASSERT_TRUE(adapted.ok());
     EXPECT_EQ(r->physics->frequenciesHz(), adapted->frequenciesHz()) << e.name;
 
+    // The answer's locator is the corrected tets' (what haptic contact is located in), not the entry's:
+    // each tet's centroid, carried from the query's frame to the locator's, is found deep in that tet.
+    ASSERT_TRUE(r->locator) << e.name;
+    const core::TetMesh& tets = r->physics->tetMesh;
+    for (std::size_t t = 0; t < tets.tetCount(); t += 7) {
+      core::Vec3 centroid = core::Vec3::Zero();
+      for (std::uint32_t node : tets.tets[t])
+        centroid += 0.25 * tets.nodes[node];
+      const core::TetLocation at = r->locator->locate(r->physics->placement.toEntry(centroid));
+      ASSERT_EQ(at.tet, t) << e.name;
+      for (double w : at.weights)
+        EXPECT_NEAR(w, 0.25, 1e-6) << e.name << " tet " << t;
+    }
+
     // One candidate: the best match, whatever the others' morphs.
     if (checked > 1) continue;
     options.correctionCandidates = 1;

@@ -23,7 +23,8 @@ Result<std::vector<SceneObject>> loadScene(const std::filesystem::path& director
                                            const io::LoadOptions& options = {});
 
 /// Augmentation by the database (Algorithm 1): query, fetch, adapt to `options.material`, link. The
-/// contact locator is the entry's own, shared through the database's cache. `options.adapt` and
+/// contact locator is the answer's (QueryResult::locator): the entry's own, shared through the database's
+/// cache, or with options.correct the corrected tets'. `options.adapt` and
 /// `options.link` are forced on. The database must outlive the function; it is safe to call from
 /// several workers at once.
 AugmentFunction databaseAugmenter(const io::Database& database, io::QueryOptions options);

@@ -98,6 +98,10 @@ struct QueryResult {
   /// With adapt: the answered match's data (or, corrected, the data of its tets morphed onto the query) in
   /// the query's frame, size and material.
   std::optional<core::AdaptedPhysics> physics;
+  /// With adapt: a locator of the answer's tets in their canonical frame (physics->placement carries the
+  /// query's frame there): the corrected tets' when corrected, else the entry's own, shared with the cache.
+  /// What contact with the object is located in (the haptic loop's), as the link is.
+  std::shared_ptr<const core::TetLocator> locator;
   core::SurfaceLink link;  ///< with QueryOptions::link
   /// With fidelity, adapt and link: how wrong the answer's first non-rigid frequency probably is
   /// (core/error_model.h; 0.1 is 10 %), from the answered match's fidelity report, the share of the query's
