@@ -84,6 +84,22 @@ Result<std::filesystem::path> suiteDatabase() {
   return path;
 }
 
+/// The shape an entry of the suite's database was built from: its family, and its index from its name
+/// ("box-00003").
+volume::ShapeSpec entrySpec(const EntryRecord& e) {
+  return volume::familySpec(e.family,
+                            static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+}
+
+/// Every entry's own surface, each under a random similarity (scale 0.5 to 2), in entry order.
+std::vector<core::TriangleMesh> ownSurfacesUnderSimilarities(const Database& db, std::mt19937_64& rng) {
+  std::vector<core::TriangleMesh> surfaces;
+  for (const EntryRecord& e : db.entries())
+    surfaces.push_back(core::transformed(*volume::makeFamilyShape(entrySpec(e), db.parameters().resolution),
+                                         test::randomSimilarity(rng, 3.0, 0.5, 2.0)));
+  return surfaces;
+}
+
 /// Whether a shape has a continuous symmetry that its normalization leaves open (two equal principal
 /// moments and no angular harmonic of order 2 to 6 about the third axis: a ring, a cup, a tube). A query
 /// finds it by the turns about that axis that it samples, so the match's frame is the query's only to
@@ -125,8 +141,7 @@ TEST_F(SmallDatabase, EveryEntryQueriedWithItsOwnSurfaceUnderARigidTransformIsTo
   ASSERT_EQ(db->entries().size(), kPerFamily * volume::generatedFamilies().size());
   std::mt19937_64 rng(2024);
   for (const EntryRecord& e : db->entries()) {
-    const volume::ShapeSpec spec = volume::familySpec(
-        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    const volume::ShapeSpec spec = entrySpec(e);
     ASSERT_EQ(spec.name(), e.name);
     auto surface = volume::makeFamilyShape(spec, db->parameters().resolution);
     ASSERT_TRUE(surface.ok());
@@ -163,8 +178,7 @@ TEST_F(SmallDatabase, PhysicsReadBackMatchesAFreshComputation) {
   const EntryRecord& e = db->entries()[4];
   auto physics = db->physics(e.id);
   ASSERT_TRUE(physics.ok()) << physics.error().message;
-  const auto index = static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1)));
-  auto surface = volume::makeFamilyShape(volume::familySpec(e.family, index), db->parameters().resolution);
+  auto surface = volume::makeFamilyShape(entrySpec(e), db->parameters().resolution);
   ASSERT_TRUE(surface.ok());
   auto fresh = volume::computeEntry(*surface, db->parameters().entry);
   ASSERT_TRUE(fresh.ok());
@@ -205,8 +219,7 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
   const core::Material glass = *core::materialPreset("glass");
   for (std::size_t i = 0; i < db->entries().size(); i += kPerFamily) {  // one entry of each family
     const EntryRecord& e = db->entries()[i];
-    const volume::ShapeSpec spec = volume::familySpec(
-        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    const volume::ShapeSpec spec = entrySpec(e);
     auto surface = volume::makeFamilyShape(spec, db->parameters().resolution);
     ASSERT_TRUE(surface.ok());
     const core::TriangleMesh query =
@@ -333,13 +346,7 @@ TEST_F(SmallDatabase, ConcurrentQueriesAgreeWithSerialOnes) {
   auto db = Database::open(sPath, small);
   ASSERT_TRUE(db.ok());
   std::mt19937_64 rng(5);
-  std::vector<core::TriangleMesh> queries;
-  for (const EntryRecord& e : db->entries()) {
-    const volume::ShapeSpec spec = volume::familySpec(
-        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
-    queries.push_back(core::transformed(*volume::makeFamilyShape(spec, db->parameters().resolution),
-                                        test::randomSimilarity(rng, 3.0, 0.5, 2.0)));
-  }
+  const std::vector<core::TriangleMesh> queries = ownSurfacesUnderSimilarities(*db, rng);
   std::vector<core::EntryId> serial;
   std::vector<double> serialHz;
   for (const auto& q : queries) {
@@ -377,8 +384,7 @@ TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQu
   std::size_t checked = 0;
   for (std::size_t n = 0; n < db->entries().size(); n += 8) {
     const EntryRecord& e = db->entries()[n];
-    const volume::ShapeSpec spec = volume::familySpec(
-        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
+    const volume::ShapeSpec spec = entrySpec(e);
     core::TriangleMesh query = *volume::makeFamilyShape(spec, db->parameters().resolution);
     for (core::Vec3& v : query.vertices)
       v = stretch * v;
@@ -461,13 +467,7 @@ TEST_F(SmallDatabase, ABurstIsAnsweredInInputOrderExactlyAsEachMeshAlone) {
   auto db = Database::open(sPath, small);
   ASSERT_TRUE(db.ok());
   std::mt19937_64 rng(11);
-  std::vector<core::TriangleMesh> burst;
-  for (const EntryRecord& e : db->entries()) {
-    const volume::ShapeSpec spec = volume::familySpec(
-        e.family, static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
-    burst.push_back(core::transformed(*volume::makeFamilyShape(spec, db->parameters().resolution),
-                                      test::randomSimilarity(rng, 3.0, 0.5, 2.0)));
-  }
+  std::vector<core::TriangleMesh> burst = ownSurfacesUnderSimilarities(*db, rng);
   std::shuffle(burst.begin(), burst.end(), rng);
   for (std::size_t i = 0; i < 4; ++i)
     burst.push_back(burst[i]);
