@@ -477,12 +477,6 @@ Result<std::shared_ptr<const core::PhysicalData>> Database::physics(core::EntryI
   return std::shared_ptr<const core::PhysicalData>(*e, &(*e)->data);
 }
 
-Result<std::shared_ptr<const core::TetLocator>> Database::locator(core::EntryId id) const {
-  auto e = mImpl->cachedEntry(id);
-  if (!e) return e.error();
-  return std::shared_ptr<const core::TetLocator>(*e, &(*e)->locator);
-}
-
 std::array<std::size_t, 2> Database::cacheStats() const {
   std::lock_guard lock(mImpl->cacheMutex);
   return {mImpl->hits, mImpl->misses};

@@ -181,8 +181,6 @@ class Database {
                                              const QueryOptions& options = {}) const;
   /// One entry's physical data, from the cache or the file. Errors: Store::physics's.
   Result<std::shared_ptr<const core::PhysicalData>> physics(core::EntryId id) const;
-  /// One entry's point locator (its tets and their boundary), built once per cached entry.
-  Result<std::shared_ptr<const core::TetLocator>> locator(core::EntryId id) const;
   /// Cache statistics: hits and misses since open.
   std::array<std::size_t, 2> cacheStats() const;
 
