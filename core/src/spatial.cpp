@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 
 #include <shapedb/core/spatial.h>
@@ -45,52 +46,104 @@ namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
 
-double boxSquaredDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).squaredNorm();
+// The nearest float at or below x, and at or above it: a box rounded outward still holds what the
+// double one did. Beyond float's range, the largest float or infinity (a conversion there is undefined).
+constexpr float kFloatMax = std::numeric_limits<float>::max();
+constexpr float kFloatInfinity = std::numeric_limits<float>::infinity();
+
+float floatBelow(double x) {
+  if (x >= static_cast<double>(kFloatMax)) return kFloatMax;
+  if (x < -static_cast<double>(kFloatMax)) return -kFloatInfinity;
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -kFloatInfinity) : f;
+}
+
+float floatAbove(double x) {
+  return -floatBelow(-x);
+}
+
+Vec3 toVec3(const std::array<float, 3>& a) {
+  return {a[0], a[1], a[2]};
+}
+
+double boxSquaredDistance(const Vec3& p, const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
+  return (toVec3(lo) - p).cwiseMax(p - toVec3(hi)).cwiseMax(0.0).squaredNorm();
+}
+
+// How many nodes build() makes for n triangles: each split halves a range, so the count follows from n
+// alone (reserved exactly: a vector that grew would hold both buffers at once).
+std::size_t treeNodeCount(std::uint32_t n, std::map<std::uint32_t, std::size_t>& memo) {
+  if (n <= kLeafSize) return 1;
+  if (auto it = memo.find(n); it != memo.end()) return it->second;
+  const std::size_t count = 1 + treeNodeCount(n / 2, memo) + treeNodeCount(n - n / 2, memo);
+  memo.emplace(n, count);
+  return count;
 }
 
 }  // namespace
 
 ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) {
   const auto n = static_cast<std::uint32_t>(surface.triangles.size());
+  if (n == 0) return;
   mOrder.resize(n);
   std::iota(mOrder.begin(), mOrder.end(), 0u);
-  mCorners.resize(n);
-  std::vector<Vec3> centroids(n);
-  for (std::uint32_t t = 0; t < n; ++t) {
-    const auto& tri = surface.triangles[t];
-    mCorners[t] = {surface.vertices[tri[0]], surface.vertices[tri[1]], surface.vertices[tri[2]]};
-    centroids[t] = (mCorners[t].a + mCorners[t].b + mCorners[t].c) / 3.0;
+  {
+    std::vector<Vec3> centroids(n);
+    for (std::uint32_t t = 0; t < n; ++t) {
+      const auto& tri = surface.triangles[t];
+      centroids[t] = (surface.vertices[tri[0]] + surface.vertices[tri[1]] + surface.vertices[tri[2]]) / 3.0;
+    }
+    std::map<std::uint32_t, std::size_t> memo;
+    mNodes.reserve(treeNodeCount(n, memo));
+    build(0, n, surface, centroids);
   }
-  mNodes.reserve(2 * (n / kLeafSize + 1));
-  if (n > 0) build(0, n, centroids);
-  // Corners in leaf order, so that a leaf's triangles sit next to each other.
-  std::vector<Corners> ordered(n);
+  // Triangles in leaf order, so that a leaf's sit next to each other, and the vertices numbered as the
+  // leaves first use them, so that a leaf's corners are near each other in memory too.
+  constexpr std::uint32_t kUnseen = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> renumbered(surface.vertices.size(), kUnseen);
+  mTriangles.resize(n);
   mPosition.resize(n);
+  mVertices.reserve(surface.vertices.size());
   for (std::uint32_t i = 0; i < n; ++i) {
-    ordered[i] = mCorners[mOrder[i]];
+    const auto& tri = surface.triangles[mOrder[i]];
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t& v = renumbered[tri[k]];
+      if (v == kUnseen) {
+        v = static_cast<std::uint32_t>(mVertices.size());
+        mVertices.push_back(surface.vertices[tri[k]]);
+      }
+      mTriangles[i][k] = v;
+    }
     mPosition[mOrder[i]] = i;
   }
-  mCorners = std::move(ordered);
+  mVertices.shrink_to_fit();  // a no-op unless the surface has vertices no triangle uses
+}
+
+TrianglePoint ClosestPointTree::closestOnTriangle(const Vec3& p, std::uint32_t position) const {
+  const auto& t = mTriangles[position];
+  return closestPointOnTriangle(p, mVertices[t[0]], mVertices[t[1]], mVertices[t[2]]);
 }
 
 // Splits the triangles mOrder[begin, end) at the median centroid along the centroids' longest extent;
 // boxes are merged bottom-up, so each triangle's corners are read once, at its leaf.
-std::int32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end,
-                                     const std::vector<Vec3>& centroids) {
-  const auto index = static_cast<std::int32_t>(mNodes.size());
+std::uint32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
+                                      const std::vector<Vec3>& centroids) {
+  const auto index = static_cast<std::uint32_t>(mNodes.size());
   mNodes.emplace_back();
-  mNodes.back().begin = begin;
-  mNodes.back().end = end;
   if (end - begin <= kLeafSize) {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const Corners& c = mCorners[mOrder[i]];
-      lo = lo.cwiseMin(c.a).cwiseMin(c.b).cwiseMin(c.c);
-      hi = hi.cwiseMax(c.a).cwiseMax(c.b).cwiseMax(c.c);
+    for (std::uint32_t i = begin; i < end; ++i)
+      for (std::uint32_t v : surface.triangles[mOrder[i]]) {
+        lo = lo.cwiseMin(surface.vertices[v]);
+        hi = hi.cwiseMax(surface.vertices[v]);
+      }
+    Node& leaf = mNodes[index];
+    for (int a = 0; a < 3; ++a) {
+      leaf.min[a] = floatBelow(lo[a]);
+      leaf.max[a] = floatAbove(hi[a]);
     }
-    mNodes[static_cast<std::size_t>(index)].min = lo;
-    mNodes[static_cast<std::size_t>(index)].max = hi;
+    leaf.first = begin;
+    leaf.count = end - begin;
     return index;
   }
   Vec3 cmin = Vec3::Constant(std::numeric_limits<double>::infinity()), cmax = -cmin;
@@ -103,13 +156,14 @@ std::int32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end,
   const std::uint32_t mid = begin + (end - begin) / 2;
   std::nth_element(mOrder.begin() + begin, mOrder.begin() + mid, mOrder.begin() + end,
                    [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
-  const std::int32_t left = build(begin, mid, centroids);
-  const std::int32_t right = build(mid, end, centroids);
-  Node& node = mNodes[static_cast<std::size_t>(index)];
-  node.left = left;
-  node.right = right;
-  node.min = mNodes[static_cast<std::size_t>(left)].min.cwiseMin(mNodes[static_cast<std::size_t>(right)].min);
-  node.max = mNodes[static_cast<std::size_t>(left)].max.cwiseMax(mNodes[static_cast<std::size_t>(right)].max);
+  const std::uint32_t left = build(begin, mid, surface, centroids);
+  const std::uint32_t right = build(mid, end, surface, centroids);
+  Node& node = mNodes[index];
+  node.first = right;
+  for (int a = 0; a < 3; ++a) {
+    node.min[a] = std::min(mNodes[left].min[a], mNodes[right].min[a]);
+    node.max[a] = std::max(mNodes[left].max[a], mNodes[right].max[a]);
+  }
   return index;
 }
 
@@ -119,23 +173,21 @@ ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p) const {
 
 ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p, std::uint32_t hint) const {
   if (hint >= mPosition.size()) return closest(p);
-  const Corners& c = mCorners[mPosition[hint]];
-  const TrianglePoint q = closestPointOnTriangle(p, c.a, c.b, c.c);
+  const TrianglePoint q = closestOnTriangle(p, mPosition[hint]);
   return search(p, Hit{hint, q}, q.squaredDistance);
 }
 
 ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double bestSq) const {
-  std::array<std::pair<std::int32_t, double>, 64> stack;
+  std::array<std::pair<std::uint32_t, double>, 64> stack;
   int top = 0;
   stack[top++] = {0, boxSquaredDistance(p, mNodes[0].min, mNodes[0].max)};
   while (top > 0) {
     const auto [index, boxSq] = stack[--top];
     if (boxSq >= bestSq) continue;
     const Node& node = mNodes[index];
-    if (node.left < 0) {
-      for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const Corners& c = mCorners[i];
-        const TrianglePoint q = closestPointOnTriangle(p, c.a, c.b, c.c);
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const TrianglePoint q = closestOnTriangle(p, i);
         if (q.squaredDistance < bestSq) {
           bestSq = q.squaredDistance;
           best = {mOrder[i], q};
@@ -143,17 +195,16 @@ ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double b
       }
       continue;
     }
-    const Node& l = mNodes[node.left];
-    const Node& r = mNodes[node.right];
-    const double dl = boxSquaredDistance(p, l.min, l.max);
-    const double dr = boxSquaredDistance(p, r.min, r.max);
+    const std::uint32_t left = index + 1, right = node.first;
+    const double dl = boxSquaredDistance(p, mNodes[left].min, mNodes[left].max);
+    const double dr = boxSquaredDistance(p, mNodes[right].min, mNodes[right].max);
     // Nearer child on top of the stack. A median-split tree over 2³² triangles is < 64 deep.
     if (dl < dr) {
-      stack[top++] = {node.right, dr};
-      stack[top++] = {node.left, dl};
+      stack[top++] = {right, dr};
+      stack[top++] = {left, dl};
     } else {
-      stack[top++] = {node.left, dl};
-      stack[top++] = {node.right, dr};
+      stack[top++] = {left, dl};
+      stack[top++] = {right, dr};
     }
   }
   return best;
