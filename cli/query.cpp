@@ -38,6 +38,7 @@ struct QueryCommandOptions {
   bool json = false;
   bool timing = false;
   bool noFidelity = false;
+  bool approximate = false;
   bool stretch = false;
   bool correct = false;
   int correctCandidates = io::QueryOptions{}.correctionCandidates;
@@ -286,6 +287,7 @@ nlohmann::json queryJson(const std::string& file, const io::LoadedMesh& loaded,
                       {"scale", loaded.scale},
                       {"flipped_inside_out", loaded.flippedInsideOut},
                       {"welded_vertices", loaded.verticesWelded},
+                      {"approximate", r.massProperties.isApproximate},
                       {"volume", r.massProperties.volume},
                       {"size", std::cbrt(r.massProperties.volume)},
                       {"descriptor", descriptor}};
@@ -301,6 +303,14 @@ nlohmann::json queryJson(const std::string& file, const io::LoadedMesh& loaded,
                      {"area_after", repaired->areaAfter}};
   q.update(answerJson(r));
   return q;
+}
+
+/// What query adds to a refusal of a surface that bounds no solid: the flag that answers it anyway.
+std::string approximateHint(const Error& error) {
+  if (error.code == ErrorCode::kNotClosed || error.code == ErrorCode::kNonManifold ||
+      error.code == ErrorCode::kInconsistentOrientation)
+    return "; --approximate answers it from vertex point masses (marked approximate)";
+  return "";
 }
 
 /// A query's file as read, its mesh moved out into the batch that queryMany answers.
@@ -367,6 +377,7 @@ io::QueryOptions queryOptionsOf(const QueryCommandOptions& o) {
                                                     : core::SearchMethod::kPruned;
   options.search.momentWeight = o.momentWeight;
   options.fidelity = !o.noFidelity;
+  options.approximate = o.approximate;
   options.stretchCorrection = o.stretch;
   options.correct = o.correct;
   options.correctionCandidates = o.correctCandidates;
@@ -424,18 +435,24 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
       const core::TriangleMesh& mesh = meshes[b];
       const Result<io::QueryResult>& result = results[b];
       if (!result) {
-        printError(f.file + ": " + result.error().message + flagHint(result.error()));
+        printError(f.file + ": " + result.error().message + approximateHint(result.error()) +
+                   flagHint(result.error()));
         status = kExitInputError;
         continue;
       }
-      // Learned unless its answer is predicted to be good enough already (--enrich-above).
-      const bool learn = enricher && (o.enrichAbove <= 0.0 || !result->predictedFrequencyError ||
-                                      *result->predictedFrequencyError > o.enrichAbove);
+      // Learned unless its answer is predicted to be good enough already (--enrich-above), or there is
+      // no solid to learn (an approximate answer's open surface cannot be tetrahedralized).
+      const bool learn = enricher && !result->massProperties.isApproximate &&
+                         (o.enrichAbove <= 0.0 || !result->predictedFrequencyError ||
+                          *result->predictedFrequencyError > o.enrichAbove);
+      if (enricher && result->massProperties.isApproximate)
+        std::fprintf(stderr, "shapedb: %s: not learned: it bounds no solid (answered approximately)\n",
+                     f.file.c_str());
       if (learn)
         pending.push_back(
             {f.file, mesh, queries.size(),
              enricher->submit({std::filesystem::path(f.file).filename().string(), f.file, mesh})});
-      else if (enricher && !o.json)
+      else if (enricher && !o.json && !result->massProperties.isApproximate)
         std::fprintf(stderr, "shapedb: %s: not learned: predicted error %.1f %% is within --enrich-above\n",
                      f.file.c_str(), 100.0 * *result->predictedFrequencyError);
       if (!o.exportDir.empty())
@@ -507,6 +524,10 @@ Command addQueryCommand(CLI::App& parent) {
   app->add_flag("--table", o->table,
                 "One line per mesh: best match, fidelity, mass, first three frequencies");
   app->add_flag("--no-fidelity", o->noFidelity, "Skip the fidelity report (it fetches every match's tets)");
+  app->add_flag("--approximate", o->approximate,
+                "Answer an open or non-manifold surface (a scan with holes) too: its mass properties from\n"
+                "vertex point masses (a shell's inertia), the answer marked approximate; --repair closes\n"
+                "small holes instead, for exact mass properties");
   app->add_flag("--stretch", o->stretch,
                 "Take the frequencies and modes from the entry stretched along its axes to the mesh's\n"
                 "proportions (second moments), by Rayleigh-Ritz on its modes, instead of scaling it\n"

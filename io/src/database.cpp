@@ -339,7 +339,9 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   out.times.validate = microsecondsSince(t);
 
   t = Clock::now();
-  auto mass = core::computeMassProperties(mesh, topology);
+  core::MassPropertiesOptions massOptions;
+  massOptions.allowApproximate = options.approximate;
+  auto mass = core::computeMassProperties(mesh, topology, massOptions);
   if (!mass) return mass.error();
   out.massProperties = *mass;
   auto normalization = core::normalize(mesh, *mass);
@@ -418,6 +420,10 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     if (!adapted) return adapted.error();
     out.physics = std::move(adapted).value();
     if (!correctionWarning.empty()) out.physics->warnings.push_back(correctionWarning);
+    if (out.massProperties.isApproximate)
+      out.physics->warnings.push_back(
+          "approximate: the surface bounds no well-defined solid, so its mass, centre and inertia are "
+          "estimated from vertex point masses (a shell's inertia, larger than the solid's)");
     out.times.adapt = microsecondsSince(t);
     if (options.link) {
       t = Clock::now();

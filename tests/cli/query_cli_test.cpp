@@ -145,7 +145,8 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
 }
 
 // A closed mesh with holes punched in it is refused, with the flag that gets past it; with --repair it is
-// answered as the closed mesh is: the same match, mass and first frequency within 2 %.
+// answered as the closed mesh is: the same match, mass and first frequency within 2 %; with --approximate,
+// as it is, marked approximate.
 TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
   test::ScratchDir dir("query-cli-repair");
   const auto db = dir / "small.db";
@@ -165,15 +166,16 @@ TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
   test::ProcessResult refused = test::runProcess(SHAPEDB_CLI, {"query", db.string(), holedPath.string()});
   EXPECT_EQ(refused.exitCode, 1);
   EXPECT_NE(refused.err.find("--repair"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--approximate"), std::string::npos) << refused.err;
 
-  const auto answer = [&](const std::filesystem::path& mesh, bool repair) {
+  const auto answer = [&](const std::filesystem::path& mesh, const char* flag) {
     std::vector<std::string> args = {"query", db.string(), mesh.string(), "--json", "--no-fidelity"};
-    if (repair) args.push_back("--repair");
+    if (flag) args.push_back(flag);
     test::ProcessResult q = test::runProcess(SHAPEDB_CLI, args);
     EXPECT_EQ(q.exitCode, 0) << q.err;
     return q.exitCode == 0 ? nlohmann::json::parse(q.out)["queries"][0] : nlohmann::json();
   };
-  const nlohmann::json original = answer(closedPath, false), repaired = answer(holedPath, true);
+  const nlohmann::json original = answer(closedPath, nullptr), repaired = answer(holedPath, "--repair");
   ASSERT_FALSE(original.is_null());
   ASSERT_FALSE(repaired.is_null());
   ASSERT_TRUE(repaired.contains("repaired"));
@@ -185,6 +187,32 @@ TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
   EXPECT_NEAR(repaired["physics"]["frequencies_hz"][0].get<double>() /
                   original["physics"]["frequencies_hz"][0].get<double>(),
               1.0, 0.02);
+  EXPECT_FALSE(original["approximate"].get<bool>());
+  EXPECT_FALSE(repaired["approximate"].get<bool>());
+
+  // --approximate answers the open surface as it is: the mass from the volume of its fan about the
+  // vertices' centroid (the holes' cones are missing: a fraction of a per cent here), the inertia a
+  // shell's, and the answer marked approximate. The descriptor is the surface's, holes and all, but the
+  // shell's moments enter the distance too: an entry of the same family, not necessarily the same one.
+  // The closed one is answered exactly with or without the flag.
+  const nlohmann::json approximate = answer(holedPath, "--approximate");
+  ASSERT_FALSE(approximate.is_null());
+  EXPECT_TRUE(approximate["approximate"].get<bool>());
+  EXPECT_EQ(approximate["matches"][0]["family"], original["matches"][0]["family"]);
+  EXPECT_NEAR(approximate["physics"]["mass"].get<double>() / original["physics"]["mass"].get<double>(), 1.0,
+              0.01);
+  ASSERT_FALSE(approximate["physics"]["warnings"].empty());
+  EXPECT_NE(approximate["physics"]["warnings"][0].get<std::string>().find("approximate"), std::string::npos)
+      << approximate["physics"]["warnings"];
+  // A shell's moments of inertia exceed the solid's (by 5/3 for a sphere).
+  for (int i = 0; i < 3; ++i)
+    EXPECT_GT(approximate["physics"]["principal_moments"][i].get<double>(),
+              1.2 * original["physics"]["principal_moments"][i].get<double>());
+  const nlohmann::json exact = answer(closedPath, "--approximate");
+  ASSERT_FALSE(exact.is_null());
+  EXPECT_FALSE(exact["approximate"].get<bool>());
+  EXPECT_EQ(exact["physics"]["mass"], original["physics"]["mass"]);
+  EXPECT_TRUE(exact["physics"]["warnings"].empty()) << exact["physics"]["warnings"];
 }
 
 TEST(QueryCli, BadInputsAreClearErrors) {

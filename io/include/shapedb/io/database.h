@@ -31,6 +31,13 @@ struct QueryOptions {
   core::SearchOptions search;  ///< k, method
   core::OrientationOptions orientation;
   core::Material material = core::materialPresets()[0];  ///< steel
+  /// Accept a surface that bounds no well-defined solid (open, as a scan with holes is; non-manifold;
+  /// inconsistently oriented): its mass properties from the paper's vertex point masses (§4.1), which
+  /// give a shell's inertia, larger than the solid's (about 5/3 for a sphere). The descriptors need only
+  /// the surface. The answer says so: massProperties.isApproximate, and a warning in physics->warnings.
+  /// A closed surface is computed exactly either way. false: such a surface is an error (kNotClosed,
+  /// kNonManifold, kInconsistentOrientation).
+  bool approximate = false;
   /// Fetch the best match's physical data, adapt it to the query (size, frame, material) and link the
   /// query's vertices to its tets. false: matching only.
   bool adapt = true;
