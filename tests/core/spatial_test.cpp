@@ -15,13 +15,12 @@
 namespace shapedb::core {
 namespace {
 
-TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
-  std::mt19937_64 rng(7);
-  const TriangleMesh surface =
-      transformed(makeUvEllipsoid({1.0, 0.6, 0.3}, 24, 12), test::randomSimilarity(rng));
+// The tree's closest point against every triangle's, at points spread `spread` times the surface's extent
+// about it: unhinted, hinted by the previous point's answer, and hinted by an arbitrary triangle.
+void expectAgreesWithEveryTriangle(const TriangleMesh& surface, std::mt19937_64& rng, double spread) {
   const ClosestPointTree tree(surface);
   const Bounds b = computeBounds(surface);
-  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  std::uniform_real_distribution<double> u(0.5 - 0.5 * spread, 0.5 + 0.5 * spread);
   std::uint32_t previous = 0;
   for (int i = 0; i < 2000; ++i) {
     const Vec3 p = b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent());
@@ -30,7 +29,6 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
       best = std::min(best, closestPointOnTriangle(p, surface.vertices[t[0]], surface.vertices[t[1]],
                                                    surface.vertices[t[2]])
                                 .squaredDistance);
-    // Unhinted, hinted by the previous point's answer, and hinted by an arbitrary triangle.
     const std::uint32_t arbitrary = static_cast<std::uint32_t>(rng() % surface.triangles.size());
     for (const auto& hit : {tree.closest(p), tree.closest(p, previous), tree.closest(p, arbitrary)}) {
       ASSERT_NEAR(hit.closest.squaredDistance, best, 1e-12 * (1 + best)) << "point " << i;
@@ -38,10 +36,35 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
       const auto& w = hit.closest.barycentric;
       const Vec3 q =
           w[0] * surface.vertices[t[0]] + w[1] * surface.vertices[t[1]] + w[2] * surface.vertices[t[2]];
-      ASSERT_LT((q - hit.closest.point).norm(), 1e-9);
+      ASSERT_LT((q - hit.closest.point).norm(), 1e-9 + 1e-13 * q.norm());
     }
     previous = tree.closest(p).triangle;
   }
+}
+
+TEST(ClosestPointTree, AgreesWithEveryTriangleOnRandomPoints) {
+  std::mt19937_64 rng(7);
+  expectAgreesWithEveryTriangle(
+      transformed(makeUvEllipsoid({1.0, 0.6, 0.3}, 24, 12), test::randomSimilarity(rng)), rng, 2.0);
+}
+
+// The boxes are single precision, rounded outward: where a float's step is as large as the triangles
+// (a 2 cm scan 400 km from the origin) or coordinates are beyond float's range, the answers are still
+// every triangle's closest, however near the surface the points are.
+TEST(ClosestPointTree, AgreesWithEveryTriangleWhereFloatBoxesAreCoarse) {
+  std::mt19937_64 rng(8);
+  for (const Vec3& offset : {Vec3(4e5, -3e5, 2e5), Vec3(0, 0, 0)}) {
+    TriangleMesh surface = makeUvEllipsoid({0.02, 0.012, 0.006}, 24, 12);
+    for (Vec3& p : surface.vertices)
+      p += offset;
+    SCOPED_TRACE(offset.transpose());
+    expectAgreesWithEveryTriangle(surface, rng, 1.2);
+  }
+  TriangleMesh huge = makeUvEllipsoid({1.0, 0.6, 0.3}, 16, 8);
+  for (Vec3& p : huge.vertices)
+    p *= 1e39;  // beyond float's largest, 3.4e38
+  SCOPED_TRACE("beyond float's range");
+  expectAgreesWithEveryTriangle(huge, rng, 1.5);
 }
 
 TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
