@@ -65,6 +65,32 @@ Status checkStlFraming(const std::filesystem::path& path, std::uintmax_t fileSiz
   return fileError(path, ErrorCode::kParse, "not an STL file (too short for binary, no 'solid' for ASCII)");
 }
 
+std::string formatBytes(std::uint64_t bytes) {
+  char text[32];
+  if (bytes >= (std::uint64_t{1} << 30))
+    std::snprintf(text, sizeof text, "%.2f GiB", static_cast<double>(bytes) / (1u << 30));
+  else
+    std::snprintf(text, sizeof text, "%.0f MiB", static_cast<double>(bytes) / (1u << 20));
+  return text;
+}
+
+// The file's mesh against the memory there is (LoadOptions::memoryBudget), before it is read. A file
+// under 1 MiB holds at most about 260,000 faces (some 40 MB once loaded and queried): not checked.
+Status checkFits(const std::filesystem::path& path, std::uintmax_t fileSize,
+                 const std::optional<std::uint64_t>& memoryBudget) {
+  if (fileSize < (1u << 20) || memoryBudget == std::uint64_t{0}) return Ok{};
+  const std::optional<std::uint64_t> budget = memoryBudget ? memoryBudget : availableMemory();
+  if (!budget) return Ok{};
+  const Result<MeshFileSize> size = estimateMeshFile(path);
+  if (!size || size->bytes() <= *budget) return Ok{};  // unreadable: the reader will say why
+  return fileError(
+      path, ErrorCode::kTooLarge,
+      "a mesh of " + std::to_string(size->triangles) + " faces and " + std::to_string(size->vertices) +
+          " vertices needs about " + formatBytes(size->bytes()) + " to be loaded and queried, and " +
+          formatBytes(*budget) +
+          " is available: not read (a machine with more memory, or the mesh simplified, will do)");
+}
+
 // Polygons fan-triangulated; polygons with fewer than three corners counted.
 struct Triangulated {
   core::TriangleMesh mesh;
@@ -160,6 +186,7 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   if (format == "stl") {
     if (Status framing = checkStlFraming(path, fileSize); !framing) return framing.error();
   }
+  if (Status fits = checkFits(path, fileSize, options.memoryBudget); !fits) return fits.error();
   Result<detail::RawPolygons> raw = format == "obj"   ? detail::readObj(path)
                                     : format == "off" ? detail::readOff(path)
                                     : format == "ply" ? detail::readPly(path)

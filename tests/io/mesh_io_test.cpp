@@ -1,5 +1,8 @@
 #include <cstring>
 #include <fstream>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -320,6 +323,73 @@ TEST(MeshIo, UnitsScaleTheCoordinatesAsTheyAreRead) {
   EXPECT_NEAR(volumeOf(metres.mesh), 0.3 * 0.2 * 0.01, 1e-12);
   EXPECT_EQ(mustFail(dir / "tray_mm.obj", {.scale = 0.0}).code, ErrorCode::kInvalidArgument);
   EXPECT_EQ(mustFail(dir / "tray_mm.obj", {.scale = -1.0}).code, ErrorCode::kInvalidArgument);
+}
+
+// A file's mesh size comes from its header (PLY, OFF, binary STL) or its lines, counted in one pass (OBJ
+// and ASCII STL over 16 MiB), and a file whose mesh would not fit in the memory there is is refused before
+// it is read, with the figures.
+TEST(MeshIo, AFileTooLargeForTheMemoryIsRefusedBeforeItIsRead) {
+  test::ScratchDir dir("mesh-io-size");
+  const TriangleMesh sphere = core::makeUvEllipsoid({0.1, 0.1, 0.1}, 800, 400);
+  ASSERT_TRUE(saveMesh(sphere, dir / "sphere.ply").ok());
+  test::writeFile(dir / "sphere.obj", test::objText(sphere));
+  test::writeFile(dir / "sphere.stl", test::binaryStl(sphere));
+  ASSERT_GT(std::filesystem::file_size(dir / "sphere.obj"), 16u << 20);  // so that its lines are counted
+  for (const char* name : {"sphere.ply", "sphere.obj"}) {
+    SCOPED_TRACE(name);
+    const Result<MeshFileSize> size = estimateMeshFile(dir / name);
+    ASSERT_TRUE(size.ok()) << size.error().message;
+    EXPECT_EQ(size->triangles, sphere.triangles.size());
+    EXPECT_EQ(size->vertices, sphere.vertices.size());
+    const Error refused = mustFail(dir / name, {.memoryBudget = size->bytes() - 1});
+    EXPECT_EQ(refused.code, ErrorCode::kTooLarge);
+    EXPECT_NE(refused.message.find(std::to_string(sphere.triangles.size()) + " faces"), std::string::npos)
+        << refused.message;
+    EXPECT_NE(refused.message.find("available"), std::string::npos) << refused.message;
+    EXPECT_EQ(mustLoad(dir / name, {.memoryBudget = size->bytes()}).mesh.triangles.size(),
+              sphere.triangles.size());
+    EXPECT_EQ(mustLoad(dir / name, {.memoryBudget = 0}).mesh.triangles.size(), sphere.triangles.size());
+  }
+  // Binary STL: its header's count; the corners merged, about half as many vertices as triangles.
+  const Result<MeshFileSize> stl = estimateMeshFile(dir / "sphere.stl");
+  ASSERT_TRUE(stl.ok()) << stl.error().message;
+  EXPECT_EQ(stl->triangles, sphere.triangles.size());
+  EXPECT_EQ(mustFail(dir / "sphere.stl", {.memoryBudget = 1u << 20}).code, ErrorCode::kTooLarge);
+
+  // A header whose count the file cannot hold is a corrupt file, not a huge mesh: the reader says so.
+  std::string corrupt =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 4000000000\nproperty list uchar int vertex_indices\nend_header\n";
+  corrupt.resize(2u << 20, '\0');
+  test::writeFile(dir / "corrupt.ply", corrupt);
+  const Result<MeshFileSize> capped = estimateMeshFile(dir / "corrupt.ply");
+  ASSERT_TRUE(capped.ok());
+  EXPECT_LE(capped->triangles, (2u << 20) / 4);
+  EXPECT_NE(mustFail(dir / "corrupt.ply", {.memoryBudget = 1u << 30}).code, ErrorCode::kTooLarge);
+}
+
+// The memory available is the least of the system's, the control group's and the address-space limit's:
+// under `ulimit -v` (here set in a child process), little more than what the limit leaves.
+TEST(MeshIo, AvailableMemoryHonoursTheAddressSpaceLimit) {
+  const std::optional<std::uint64_t> system = availableMemory();
+  ASSERT_TRUE(system.has_value()) << "/proc/meminfo unreadable";
+  EXPECT_GT(*system, 0u);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::ifstream statm("/proc/self/statm");
+    std::uint64_t pages = 0;
+    statm >> pages;
+    const std::uint64_t mapped = pages * static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+    const rlimit limit{mapped + (64u << 20), mapped + (64u << 20)};
+    if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(2);
+    const std::optional<std::uint64_t> left = availableMemory();
+    _exit(left && *left <= (64u << 20) ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
 TEST(MeshIo, SaveRejectsUnknownFormatsAndInvalidMeshes) {

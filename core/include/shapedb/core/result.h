@@ -24,6 +24,7 @@ enum class ErrorCode {
   kZeroVolume,               ///< the surface encloses no measurable volume
   kInvalidArgument,          ///< a parameter outside its documented range
   kCancelled,                ///< work abandoned before it was done: its owner shut down first
+  kTooLarge,                 ///< the input would need more memory than there is
 };
 
 /// A recoverable failure: a code and a one-line message that names the input and the problem,

@@ -1,0 +1,184 @@
+// How large a mesh file's mesh is before it is read whole, and how much memory this process can have:
+// together they let loadMesh refuse a file that would not fit, with the figures, instead of failing
+// half way through (or being killed).
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <sys/resource.h>
+#include <unistd.h>
+#include <vector>
+
+#include <shapedb/io/mesh_io.h>
+
+namespace shapedb::io {
+namespace {
+
+constexpr std::uint64_t kCountedAbove = 16u << 20;  // text files smaller than this are not counted
+
+std::string lowercase(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// PLY's header: "element vertex N" and "element face N", up to end_header (at most 64 KiB of it).
+MeshFileSize plyHeader(std::ifstream& in) {
+  MeshFileSize size;
+  std::string line;
+  std::size_t read = 0;
+  while (std::getline(in, line) && (read += line.size() + 1) < (64u << 10)) {
+    std::istringstream words(line);
+    std::string keyword, element;
+    std::uint64_t count = 0;
+    if (!(words >> keyword)) continue;
+    if (keyword == "end_header") break;
+    if (keyword == "element" && words >> element >> count) {
+      if (element == "vertex") size.vertices = count;
+      if (element == "face") size.triangles = count;
+    }
+  }
+  return size;
+}
+
+// OFF's counts: the first line of numbers after the keyword (comments and blank lines skipped).
+MeshFileSize offHeader(std::ifstream& in) {
+  MeshFileSize size;
+  std::string line;
+  for (int lines = 0; lines < 64 && std::getline(in, line); ++lines) {
+    const std::size_t start = line.find_first_not_of(" \t\r");
+    if (start == std::string::npos || line[start] == '#') continue;
+    std::istringstream words(line.substr(start));
+    std::uint64_t vertices = 0, faces = 0;
+    if (words >> vertices >> faces) {
+      size.vertices = vertices;
+      size.triangles = faces;
+      break;
+    }
+  }
+  return size;
+}
+
+// OBJ's `v` and `f` lines, or ASCII STL's facets, counted by each line's first word, a megabyte at a
+// time.
+MeshFileSize countLines(std::ifstream& in, bool stl) {
+  MeshFileSize size;
+  std::vector<char> buffer(1u << 20);
+  std::string word;  // the line's first word so far (its first eight characters: enough to tell)
+  enum class At { kLeadingBlanks, kFirstWord, kRest } at = At::kLeadingBlanks;
+  const auto countWord = [&] {
+    if (stl && word == "facet") ++size.triangles;
+    if (!stl && word == "v") ++size.vertices;
+    if (!stl && word == "f") ++size.triangles;
+    word.clear();
+  };
+  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
+    const auto got = static_cast<std::size_t>(in.gcount());
+    for (std::size_t i = 0; i < got; ++i) {
+      const char c = buffer[i];
+      if (c == '\n') {
+        if (at == At::kFirstWord) countWord();
+        word.clear();
+        at = At::kLeadingBlanks;
+        continue;
+      }
+      const bool blank = c == ' ' || c == '\t' || c == '\r';
+      if (at == At::kLeadingBlanks && !blank) at = At::kFirstWord;
+      if (at != At::kFirstWord) continue;
+      if (blank) {
+        countWord();
+        at = At::kRest;
+      } else if (word.size() < 8) {
+        word.push_back(c);
+      }
+    }
+  }
+  if (at == At::kFirstWord) countWord();
+  if (stl) size.vertices = size.triangles / 2;  // a closed surface's, once its corners are merged
+  return size;
+}
+
+std::optional<std::uint64_t> readUnsigned(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string text;
+  if (!(in >> text)) return std::nullopt;
+  std::uint64_t value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size()) return std::nullopt;  // "max": no limit
+  return value;
+}
+
+}  // namespace
+
+Result<MeshFileSize> estimateMeshFile(const std::filesystem::path& path) {
+  std::string format = lowercase(path.extension().string());
+  if (!format.empty()) format.erase(0, 1);
+  if (format != "obj" && format != "ply" && format != "off" && format != "stl")
+    return Error{ErrorCode::kUnknownFormat,
+                 path.string() + ": unknown mesh format '" + path.extension().string() + "'"};
+  std::error_code ec;
+  const std::uintmax_t fileSize = std::filesystem::file_size(path, ec);
+  std::ifstream in(path, std::ios::binary);
+  if (ec || !in) return Error{ErrorCode::kIo, path.string() + ": cannot read file"};
+
+  MeshFileSize size;
+  if (format == "ply" || format == "off") {
+    size = format == "ply" ? plyHeader(in) : offHeader(in);
+    // A count the file cannot hold is a corrupt header (the reader will say so), not a huge mesh: at
+    // least 3 bytes a vertex (three one-byte scalars) and 4 a face (a count and three one-byte indices).
+    size.vertices = std::min<std::uint64_t>(size.vertices, fileSize / 3);
+    size.triangles = std::min<std::uint64_t>(size.triangles, fileSize / 4);
+    return size;
+  }
+  if (format == "stl") {
+    std::array<char, 84> header{};
+    in.read(header.data(), header.size());
+    std::uint32_t claimed = 0;
+    std::memcpy(&claimed, header.data() + 80, sizeof claimed);
+    if (in.gcount() == 84 && 84 + 50 * std::uintmax_t{claimed} == fileSize) {
+      size.triangles = claimed;
+      size.vertices = claimed / 2;  // once OpenMesh's reader has merged the corners
+      return size;
+    }
+    in.clear();
+    in.seekg(0);
+  }
+  if (fileSize <= kCountedAbove) return size;
+  return countLines(in, format == "stl");
+}
+
+std::optional<std::uint64_t> availableMemory() {
+  std::optional<std::uint64_t> least;
+  const auto consider = [&least](std::uint64_t bytes) { least = least ? std::min(*least, bytes) : bytes; };
+
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key, unit;
+  std::uint64_t kib = 0;
+  while (meminfo >> key >> kib >> unit)
+    if (key == "MemAvailable:") {
+      consider(kib << 10);
+      break;
+    }
+
+  // cgroup v2: this process's group's limit and use.
+  if (const std::optional<std::uint64_t> limit = readUnsigned("/sys/fs/cgroup/memory.max"))
+    if (const std::optional<std::uint64_t> used = readUnsigned("/sys/fs/cgroup/memory.current"))
+      consider(*limit > *used ? *limit - *used : 0);
+
+  // The address-space limit (ulimit -v) less what the process has mapped already.
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    std::ifstream statm("/proc/self/statm");
+    std::uint64_t pages = 0;
+    if (statm >> pages) {
+      const std::uint64_t mapped = pages * static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+      consider(limit.rlim_cur > mapped ? limit.rlim_cur - mapped : 0);
+    }
+  }
+  return least;
+}
+
+}  // namespace shapedb::io
