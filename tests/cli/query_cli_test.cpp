@@ -5,6 +5,7 @@
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -213,6 +214,84 @@ TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
   EXPECT_FALSE(exact["approximate"].get<bool>());
   EXPECT_EQ(exact["physics"]["mass"], original["physics"]["mass"]);
   EXPECT_TRUE(exact["physics"]["warnings"].empty()) << exact["physics"]["warnings"];
+}
+
+// Every real mesh of the development folder through query, each in its own unit (none of the files says
+// it: CAD exports and the knot and fox are in millimetres, the torus in centimetres, the Bob figure has
+// none and is read as decimetres, the rest are in metres), as steel: no size warning, and a mass and size
+// plausible for a steel object held in the hand. Read in metres, the millimetre ones would be houses of
+// steel: the warning names the unit. Files of the folder not in the list are queried as metres.
+TEST(QueryCli, EveryRealMeshIsAnsweredWithAPlausibleMassInItsUnit) {
+  SHAPEDB_REAL_MESHES_OR_SKIP(folder);
+  test::ScratchDir dir("query-cli-real");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::buildWithCli(db, 4, "ellipsoid,box", 4).exitCode, 0);
+  const std::vector<std::pair<std::vector<std::string>, std::vector<std::string>>> groups = {
+      {{"--units", "m"},
+       {"cad/barkour_foot.stl", "cad/cube_cup_hi.obj", "everyday/fuze_bottle.obj", "scanned/horse.ply"}},
+      {{"--units", "mm"},
+       {"cad/shadowhand_lf_metacarpal.obj", "cad/tray_bottom_1002.STL", "cad/turbineblade.ply",
+        "everyday/goblet_vase.stl", "primitive/quadknot.obj", "scanned/fox.ply"}},
+      {{"--units", "cm"}, {"primitive/torus.STL"}},
+      {{"--scale", "0.1"}, {"scanned/bob_small.ply"}},
+  };
+  std::set<std::filesystem::path> listed;
+  std::size_t answered = 0, missing = 0;
+  for (const auto& [units, files] : groups) {
+    std::vector<std::string> args = {"query", db.string(), "--json", "--no-fidelity"};
+    args.insert(args.end(), units.begin(), units.end());
+    for (const std::string& file : files) {
+      listed.insert(std::filesystem::weakly_canonical(folder / file));
+      if (std::filesystem::exists(folder / file))
+        args.push_back((folder / file).string());
+      else
+        ++missing;
+    }
+    if (args.size() == 4 + units.size()) continue;
+    test::ProcessResult q = test::runProcess(SHAPEDB_CLI, args);
+    ASSERT_EQ(q.exitCode, 0) << q.err;
+    EXPECT_EQ(q.err.find("across, read in metres"), std::string::npos) << q.err;
+    const nlohmann::json j = nlohmann::json::parse(q.out);
+    for (const nlohmann::json& answer : j["queries"]) {
+      SCOPED_TRACE(answer["file"].get<std::string>());
+      const nlohmann::json& p = answer["physics"];
+      EXPECT_EQ(p["material"]["name"], "steel");
+      EXPECT_NEAR(p["mass"].get<double>(), 7850.0 * answer["volume"].get<double>(),
+                  1e-9 * p["mass"].get<double>());
+      EXPECT_GT(p["mass"].get<double>(), 0.01);  // 10 g: a robot's foot pad is 33 g
+      EXPECT_LT(p["mass"].get<double>(), 20.0);  // 20 kg: the knot is 8 kg
+      EXPECT_GT(answer["size"].get<double>(), 0.01);
+      EXPECT_LT(answer["size"].get<double>(), 0.3);
+      EXPECT_GT(p["frequencies_hz"][0].get<double>(), 0.0);
+      ++answered;
+    }
+  }
+  EXPECT_EQ(answered, listed.size() - missing);
+
+  // The millimetre files read as metres: told so, with the unit to give.
+  std::vector<std::string> asMetres = {"query", db.string(), "--json", "--no-fidelity"};
+  for (const char* file : {"cad/tray_bottom_1002.STL", "scanned/fox.ply"})
+    if (std::filesystem::exists(folder / file)) asMetres.push_back((folder / file).string());
+  if (asMetres.size() > 4) {
+    test::ProcessResult q = test::runProcess(SHAPEDB_CLI, asMetres);
+    ASSERT_EQ(q.exitCode, 0) << q.err;
+    EXPECT_NE(q.err.find("give --units mm"), std::string::npos) << q.err;
+    const nlohmann::json j = nlohmann::json::parse(q.out);
+    EXPECT_EQ(j["queries"].size(), asMetres.size() - 4);
+    for (const nlohmann::json& answer : j["queries"])
+      EXPECT_GT(answer["physics"]["mass"].get<double>(), 1e5) << answer["file"];
+  }
+
+  // Whatever else the folder holds runs through query too.
+  auto all = io::listMeshFiles(folder);
+  ASSERT_TRUE(all.ok()) << all.error().message;
+  std::vector<std::string> others = {"query", db.string(), "--json", "--no-fidelity"};
+  for (const std::filesystem::path& file : *all)
+    if (!listed.count(std::filesystem::weakly_canonical(file))) others.push_back(file.string());
+  if (others.size() > 4) {
+    test::ProcessResult q = test::runProcess(SHAPEDB_CLI, others);
+    EXPECT_EQ(q.exitCode, 0) << q.err;
+  }
 }
 
 TEST(QueryCli, BadInputsAreClearErrors) {
