@@ -274,7 +274,10 @@ TEST_F(HostileInput, EachInputGivesItsDocumentedErrorOrResult) {
 }
 
 /// A closed UV ellipsoid of 10,000,000 triangles as binary PLY (186 MB), written directly: the query
-/// must read, validate, describe and match it with a correct volume, in bounded memory.
+/// must read, validate, describe and match it with a correct volume, in bounded memory (it peaked at
+/// 2.9 GiB until the closest-point tree of the fidelity report was made lighter; about 1.4 GiB since).
+/// Where the memory is not there (an address-space limit of 1 GB, here), the file is refused before it
+/// is read, with what it would need.
 TEST_F(HostileInput, TenMillionTriangleMeshIsQueriedInBoundedMemory) {
   const int slices = 2500, stacks = 2001;  // 2 · slices · (stacks − 1) = 10,000,000 triangles
   const TriangleMesh mesh = core::makeUvEllipsoid({0.2, 0.1, 0.05}, slices, stacks);
@@ -295,6 +298,13 @@ TEST_F(HostileInput, TenMillionTriangleMeshIsQueriedInBoundedMemory) {
     }
     ASSERT_TRUE(out.good());
   }
+  const test::ProcessResult limited =
+      test::runProcess("/bin/sh", {"-c", "ulimit -v 1000000 && exec \"$0\" \"$@\"", SHAPEDB_CLI, "query",
+                                   (*sDir / "small.db").string(), file.string(), "--json"});
+  EXPECT_EQ(limited.exitCode, 1) << limited.err;
+  EXPECT_NE(limited.err.find(file.string() + ": a mesh of 10000000 faces and "), std::string::npos)
+      << limited.err;
+  EXPECT_NE(limited.err.find("available: not read"), std::string::npos) << limited.err;
   const test::ProcessResult q =
       test::runProcess(SHAPEDB_CLI, {"query", (*sDir / "small.db").string(), file.string(), "--json"},
                        {.timeoutSeconds = 500.0});
@@ -308,7 +318,7 @@ TEST_F(HostileInput, TenMillionTriangleMeshIsQueriedInBoundedMemory) {
   EXPECT_NEAR(query["volume"].get<double>(), volume, 1e-5 * volume);
   EXPECT_EQ(query["matches"][0]["family"], "ellipsoid");
   std::printf("10M triangles: peak memory %.0f MiB\n", static_cast<double>(q.maxRssKiB) / 1024.0);
-  EXPECT_LT(q.maxRssKiB, 8 << 20) << "peak memory " << q.maxRssKiB << " KiB";
+  EXPECT_LT(q.maxRssKiB, 1'677'722) << "peak memory " << q.maxRssKiB << " KiB";  // 1.6 GiB
 }
 
 }  // namespace
