@@ -179,7 +179,8 @@ std::vector<Case> corpus() {
          open.triangles.resize(open.triangles.size() - 2);
          return test::objText(open);
        },
-       "not closed (4 boundary edges); if its vertices only nearly coincide, --weld-tolerance"},
+       "not closed (4 boundary edges); --approximate answers it from vertex point masses (marked "
+       "approximate); if its vertices only nearly coincide, --weld-tolerance"},
       {"single_triangle.obj", [] { return "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; }, "not closed"},
       {"coincident_vertices_soup.obj", [=] { return test::objText(test::soupOf(box)); }, "",
        massNear(0.3 * 0.2 * 0.1)},  // welded at load, with a warning

@@ -16,6 +16,7 @@
 #include <shapedb/volume/entry.h>
 
 #include "cli_test_support.h"
+#include "support/mesh_files.h"
 #include "support/subprocess.h"
 #include "support/test_support.h"
 
@@ -214,6 +215,56 @@ TEST(QueryCli, AMeshWithHolesIsRepairedAndAnsweredAsTheClosedOne) {
   EXPECT_FALSE(exact["approximate"].get<bool>());
   EXPECT_EQ(exact["physics"]["mass"], original["physics"]["mass"]);
   EXPECT_TRUE(exact["physics"]["warnings"].empty()) << exact["physics"]["warnings"];
+}
+
+// The same solid written as users' files have it: as it is, wound inward, as a triangle soup (every
+// triangle with its own corners), and in millimetres: the same answer from each, with a warning where the
+// file was turned over or welded.
+TEST(QueryCli, AnInsideOutCopyASoupAndAMillimetreCopyGiveTheSameAnswer) {
+  test::ScratchDir dir("query-cli-forms");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::buildWithCli(db, 4, "ellipsoid,box", 4).exitCode, 0);
+  const core::TriangleMesh solid = core::makeUvEllipsoid({0.12, 0.08, 0.05}, 48, 24);
+  core::TriangleMesh inward = solid, millimetres = solid;
+  for (auto& t : inward.triangles)
+    std::swap(t[1], t[2]);
+  for (core::Vec3& p : millimetres.vertices)
+    p *= 1000.0;
+  const auto original = dir / "solid.ply", turned = dir / "inward.ply", soup = dir / "soup.obj",
+             mm = dir / "solid_mm.ply";
+  ASSERT_TRUE(io::saveMesh(solid, original).ok());
+  ASSERT_TRUE(io::saveMesh(inward, turned).ok());
+  test::writeFile(soup, test::objText(test::soupOf(solid)));
+  ASSERT_TRUE(io::saveMesh(millimetres, mm).ok());
+
+  test::ProcessResult q = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), original.string(), turned.string(), soup.string(), "--json"});
+  ASSERT_EQ(q.exitCode, 0) << q.err;
+  EXPECT_NE(q.err.find(turned.string() + ": the surface is wound inward"), std::string::npos) << q.err;
+  EXPECT_NE(q.err.find(soup.string() + ": "), std::string::npos) << q.err;
+  EXPECT_NE(q.err.find("coincident vertices welded, which closed the surface"), std::string::npos) << q.err;
+  test::ProcessResult qmm =
+      test::runProcess(SHAPEDB_CLI, {"query", db.string(), mm.string(), "--units", "mm", "--json"});
+  ASSERT_EQ(qmm.exitCode, 0) << qmm.err;
+  EXPECT_EQ(qmm.err, "");
+
+  const nlohmann::json answers = nlohmann::json::parse(q.out)["queries"];
+  const nlohmann::json reference = answers[0];
+  std::vector<nlohmann::json> others = {answers[1], answers[2], nlohmann::json::parse(qmm.out)["queries"][0]};
+  EXPECT_TRUE(others[0]["flipped_inside_out"].get<bool>());
+  EXPECT_GT(others[1]["welded_vertices"].get<int>(), 0);
+  EXPECT_EQ(others[2]["scale"].get<double>(), 0.001);
+  for (const nlohmann::json& other : others) {
+    SCOPED_TRACE(other["file"].get<std::string>());
+    EXPECT_EQ(other["matches"][0]["name"], reference["matches"][0]["name"]);
+    // Float files: the coordinates agree to single precision.
+    EXPECT_NEAR(other["physics"]["mass"].get<double>() / reference["physics"]["mass"].get<double>(), 1.0,
+                1e-5);
+    for (int i = 0; i < 4; ++i)
+      EXPECT_NEAR(other["physics"]["frequencies_hz"][i].get<double>() /
+                      reference["physics"]["frequencies_hz"][i].get<double>(),
+                  1.0, 1e-5);
+  }
 }
 
 // Every real mesh of the development folder through query, each in its own unit (none of the files says
