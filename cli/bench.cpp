@@ -9,8 +9,8 @@
 #include <memory>
 #include <string>
 
+#include <shapedb/bench/evaluation.h>
 #include <shapedb/io/database.h>
-#include <shapedb/io/evaluation.h>
 #include <shapedb/io/mesh_io.h>
 #include <shapedb/volume/entry.h>
 #include <shapedb/volume/modal.h>
@@ -30,7 +30,7 @@ struct BenchCommandOptions {
   std::string out;
   MaterialFlags material;
   std::string directElements = "quadratic";
-  io::EvaluationOptions evaluation;
+  bench::EvaluationOptions evaluation;
 };
 
 Result<std::vector<io::NamedMesh>> loadShapes(const BenchCommandOptions& o) {
@@ -91,7 +91,8 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
     std::fprintf(stderr, "bench: %zu/%zu direct computations done (%s), %.0f s\n", done, total, name.c_str(),
                  seconds);
   };
-  Result<std::vector<io::FragmentEvaluation>> evaluations = io::evaluateShapes(*db, *shapes, o.evaluation);
+  Result<std::vector<bench::FragmentEvaluation>> evaluations =
+      bench::evaluateShapes(*db, *shapes, o.evaluation);
   if (!evaluations) {
     printError(evaluations.error().message);
     return kExitUsage;
@@ -111,9 +112,9 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
       "; truth and baselines on " + volume::toString(o.evaluation.directElements) +
       " tets, the truth's with a TetGen volume bound " + refinement +
       std::string("x smaller than the entries'");
-  for (Status st : {io::writeEvaluationCsv(*evaluations, out / "evaluation.csv"),
-                    io::writeEvaluationSummary(*evaluations, title, out / "summary.md"),
-                    io::writeEvaluationPlots(*evaluations, out)})
+  for (Status st : {bench::writeEvaluationCsv(*evaluations, out / "evaluation.csv"),
+                    bench::writeEvaluationSummary(*evaluations, title, out / "summary.md"),
+                    bench::writeEvaluationPlots(*evaluations, out)})
     if (!st) {
       printError(st.error().message);
       return kExitInputError;
@@ -121,7 +122,7 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
   std::ifstream summary(out / "summary.md");
   std::printf("%s", std::string(std::istreambuf_iterator<char>(summary), {}).c_str());
   std::size_t failed = 0;
-  for (const io::FragmentEvaluation& e : *evaluations)
+  for (const bench::FragmentEvaluation& e : *evaluations)
     failed += !e.ok();
   std::fprintf(stderr, "bench: wrote %s/{evaluation.csv, summary.md, time.png, error.png}\n", o.out.c_str());
   return failed == evaluations->size() ? kExitInputError : kExitOk;

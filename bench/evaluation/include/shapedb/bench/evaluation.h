@@ -21,7 +21,7 @@
 #include <shapedb/core/result.h>
 #include <shapedb/io/database.h>
 
-namespace shapedb::io {
+namespace shapedb::bench {
 
 /// What supplies a shape's physical data: the top-1 match of each descriptor, adapted (the method; the
 /// voxel kinds ranked with their moment term, core::SearchOptions::momentWeight), or the
@@ -125,8 +125,8 @@ struct EvaluationOptions {
 /// timings are those of an idle machine; then the direct computations and the baselines in parallel.
 /// A shape that fails is reported in its FragmentEvaluation, and the others go on.
 /// Errors: kInvalidArgument for options out of range or a material validateMaterial refuses.
-Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
-                                                       std::span<const NamedMesh> shapes,
+Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& database,
+                                                       std::span<const io::NamedMesh> shapes,
                                                        const EvaluationOptions& options = {});
 
 /// Summary statistics of one method over the shapes that were evaluated.
@@ -156,4 +156,4 @@ Status writeEvaluationSummary(std::span<const FragmentEvaluation> evaluations, c
 Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
                             const std::filesystem::path& directory);
 
-}  // namespace shapedb::io
+}  // namespace shapedb::bench

@@ -8,38 +8,38 @@
 
 #include <gtest/gtest.h>
 
+#include <shapedb/bench/evaluation.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/database.h>
-#include <shapedb/io/evaluation.h>
 #include <shapedb/volume/families.h>
 
 #include "support/test_support.h"
 
-namespace shapedb::io {
+namespace shapedb::bench {
 namespace {
 
 TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
   test::ScratchDir dir("evaluation");
   const auto path = dir / "small.db";
-  BuildOptions build;  // quadratic tets, the default
+  io::BuildOptions build;  // quadratic tets, the default
   build.parameters.entries = 8;
   build.parameters.families = {volume::Family::kBox, volume::Family::kEllipsoid};
   build.parameters.entry.modal.modes = 6;
   build.threads = 2;
-  auto report = buildDatabase(path, build);
+  auto report = io::buildDatabase(path, build);
   ASSERT_TRUE(report.ok()) << report.error().message;
-  auto db = Database::open(path);
+  auto db = io::Database::open(path);
   ASSERT_TRUE(db.ok()) << db.error().message;
 
   // An entry's own surface, turned, moved and scaled; a plain box; a smooth ellipsoid.
-  const EntryRecord& entry = db->entries()[1];
+  const io::EntryRecord& entry = db->entries()[1];
   auto surface = volume::makeFamilyShape(
       volume::familySpec(entry.family,
                          static_cast<std::uint32_t>(std::stoul(entry.name.substr(entry.name.find('-') + 1)))),
       db->parameters().resolution);
   ASSERT_TRUE(surface.ok());
   std::mt19937_64 rng(5);
-  std::vector<NamedMesh> shapes{
+  std::vector<io::NamedMesh> shapes{
       {"entry", "", core::transformed(*surface, test::randomSimilarity(rng, 2.0, 0.05, 0.2))},
       {"box", "", core::makeBox({0.3, 0.2, 0.1})},
       {"ellipsoid", "", core::makeUvEllipsoid({0.15, 0.1, 0.06}, 24, 12)},
@@ -130,7 +130,7 @@ TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
 
   // The direct computations on quadratic tets (the default): a thin plate's truth drops against linear
   // ones (which lock in bending), and the plate is still its own box baseline.
-  const std::vector<NamedMesh> plate{{"plate", "", core::makeBox({0.3, 0.2, 0.03})}};
+  const std::vector<io::NamedMesh> plate{{"plate", "", core::makeBox({0.3, 0.2, 0.03})}};
   options.progress = nullptr;
   auto quadratic = evaluateShapes(*db, plate, options);
   options.directElements = volume::ElementOrder::kLinear;
@@ -152,17 +152,17 @@ TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
 TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
   test::ScratchDir dir("evaluation-bad");
   const auto path = dir / "small.db";
-  BuildOptions build;
+  io::BuildOptions build;
   build.parameters.entries = 4;
   build.parameters.families = {volume::Family::kBox};
   build.parameters.entry.modal.modes = 4;
-  auto report = buildDatabase(path, build);
+  auto report = io::buildDatabase(path, build);
   ASSERT_TRUE(report.ok()) << report.error().message;
-  auto db = Database::open(path);
+  auto db = io::Database::open(path);
   ASSERT_TRUE(db.ok());
   core::TriangleMesh open = core::makeBox({1, 1, 1});
   open.triangles.pop_back();
-  const std::vector<NamedMesh> shapes{{"open", "", open}, {"box", "", core::makeBox({0.2, 0.1, 0.1})}};
+  const std::vector<io::NamedMesh> shapes{{"open", "", open}, {"box", "", core::makeBox({0.2, 0.1, 0.1})}};
   EvaluationOptions options;
   options.frequencies = 4;
   auto evaluations = evaluateShapes(*db, shapes, options);
@@ -178,4 +178,4 @@ TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
 }
 
 }  // namespace
-}  // namespace shapedb::io
+}  // namespace shapedb::bench

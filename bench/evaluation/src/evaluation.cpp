@@ -9,15 +9,15 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <shapedb/bench/evaluation.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/statistics.h>
 #include <shapedb/core/stretch.h>
-#include <shapedb/io/evaluation.h>
 #include <shapedb/io/plot.h>
 #include <shapedb/volume/entry.h>
 #include <shapedb/volume/simplify.h>
 
-namespace shapedb::io {
+namespace shapedb::bench {
 
 namespace {
 
@@ -83,9 +83,9 @@ void evaluateBaseline(MethodEvaluation& m, const core::TriangleMesh& surface,
   m.overlap = core::sampleOverlap(shape, placed, options.overlapResolution);
 }
 
-PlotSeries makeSeries(std::string label, std::array<std::uint8_t, 3> color,
-                      PlotSeries::Style style = PlotSeries::Style::kDots) {
-  PlotSeries s;
+io::PlotSeries makeSeries(std::string label, std::array<std::uint8_t, 3> color,
+                          io::PlotSeries::Style style = io::PlotSeries::Style::kDots) {
+  io::PlotSeries s;
   s.label = std::move(label);
   s.color = color;
   s.style = style;
@@ -165,8 +165,8 @@ volume::EntryOptions truthOptions(const volume::EntryOptions& entry, const Evalu
 
 }  // namespace
 
-Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
-                                                       std::span<const NamedMesh> shapes,
+Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& database,
+                                                       std::span<const io::NamedMesh> shapes,
                                                        const EvaluationOptions& options) {
   const volume::EntryOptions& entry = database.parameters().entry;
   const volume::EntryOptions direct = volume::withElements(entry, options.directElements);
@@ -186,7 +186,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
 
   std::vector<FragmentEvaluation> out(shapes.size());
   // 1. The queries, one at a time: their timings are those of a machine doing nothing else.
-  std::vector<std::array<std::optional<QueryResult>, kQueries.size()>> queries(shapes.size());
+  std::vector<std::array<std::optional<io::QueryResult>, kQueries.size()>> queries(shapes.size());
   struct Stretched {
     Eigen::VectorXd frequenciesHz;
     double micros = 0.0;
@@ -197,14 +197,14 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
     e.name = shapes[i].name;
     e.triangles = shapes[i].mesh.triangles.size();
     for (std::size_t k = 0; k < kQueries.size() && e.ok(); ++k) {
-      QueryOptions q;
+      io::QueryOptions q;
       q.descriptor = kQueries[k].kind;
       q.search.k = 1;
       if (kQueries[k].momentWeight) q.search.momentWeight = *kQueries[k].momentWeight;
       q.correct = kQueries[k].correct;
       q.material = options.material;
       q.fidelity = true;  // its evidence is recorded; its time is not counted
-      Result<QueryResult> r = database.query(shapes[i].mesh, q);
+      Result<io::QueryResult> r = database.query(shapes[i].mesh, q);
       if (!r)
         e.error = std::string("query (") + core::toString(kQueries[k].kind) + "): " + r.error().message;
       else
@@ -215,7 +215,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
     // pay it: the entry's stretch basis, then the adaptation. Linear-tet databases only: for the others
     // the column stays empty (no frequencies, errors NaN, left out of the medians).
     if (e.ok() && database.supportsStretchCorrection()) {
-      const QueryResult& q = *queries[i][kCentroidVoxelIndex];
+      const io::QueryResult& q = *queries[i][kCentroidVoxelIndex];
       const Clock::time_point start = Clock::now();
       const core::StretchBasis basis =
           core::computeStretchBasis(q.entryPhysics->tetMesh, q.entryPhysics->modes);
@@ -278,10 +278,10 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const Database& database,
                                          core::computeBounds(mesh)};
 
           const auto retrieved = [&](std::size_t k, EvaluationMethod method) {
-            const QueryResult& q = *queries[i][k];
+            const io::QueryResult& q = *queries[i][k];
             MethodEvaluation m;
             m.method = method;
-            const MatchReport& best = q.answeredMatch();
+            const io::MatchReport& best = q.answeredMatch();
             m.match = best.entry->name;
             m.family = volume::toString(best.entry->family);
             m.distance = best.match.distance;
@@ -523,9 +523,9 @@ Status writeEvaluationSummary(std::span<const FragmentEvaluation> evaluations, c
 
 Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
                             const std::filesystem::path& directory) {
-  PlotSeries direct = makeSeries("direct: TetGen + FEM + modes + compound", {214, 39, 40});
-  PlotSeries query = makeSeries("query, centroid-voxel: match + fetch + adapt + link", {31, 119, 180});
-  PlotSeries match = makeSeries("describe + search", {44, 160, 44});
+  io::PlotSeries direct = makeSeries("direct: TetGen + FEM + modes + compound", {214, 39, 40});
+  io::PlotSeries query = makeSeries("query, centroid-voxel: match + fetch + adapt + link", {31, 119, 180});
+  io::PlotSeries match = makeSeries("describe + search", {44, 160, 44});
   for (const FragmentEvaluation& e : evaluations) {
     if (!e.ok()) continue;
     const double t = e.volume * 1e6;  // cm³
@@ -536,19 +536,19 @@ Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
     match.x.push_back(t);
     match.y.push_back(e.methods[kCentroidVoxelIndex].matchMicros * 1e-6);
   }
-  PlotAxes timeAxes;
+  io::PlotAxes timeAxes;
   timeAxes.title = "Physical data for each shape: computed directly, or queried";
   timeAxes.xLabel = "volume of the shape, cm3";
   timeAxes.yLabel = "seconds";
   timeAxes.logX = timeAxes.logY = true;
-  const std::vector<PlotSeries> timeSeries{direct, query, match};
-  if (Status st = savePng(plotChart(timeAxes, timeSeries), directory / "time.png"); !st) return st;
+  const std::vector<io::PlotSeries> timeSeries{direct, query, match};
+  if (Status st = io::savePng(io::plotChart(timeAxes, timeSeries), directory / "time.png"); !st) return st;
 
-  PlotAxes errorAxes;
+  io::PlotAxes errorAxes;
   errorAxes.title = "First-frequency error against the direct computation, per shape";
   errorAxes.xLabel = "method (bars: medians)";
   errorAxes.yLabel = "|f1 - f1*| / f1*, %";
-  std::vector<PlotSeries> errorSeries;
+  std::vector<io::PlotSeries> errorSeries;
   const std::array<std::array<std::uint8_t, 3>, kEvaluationMethods.size()> colors{{{148, 103, 189},
                                                                                    {255, 127, 14},
                                                                                    {31, 119, 180},
@@ -557,10 +557,10 @@ Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
                                                                                    {23, 190, 207},
                                                                                    {188, 189, 34},
                                                                                    {214, 39, 40}}};
-  PlotSeries medians = makeSeries("", {0, 0, 0}, PlotSeries::Style::kTicks);
+  io::PlotSeries medians = makeSeries("", {0, 0, 0}, io::PlotSeries::Style::kTicks);
   for (std::size_t k = 0; k < kEvaluationMethods.size(); ++k) {
     errorAxes.categories.push_back(toString(kEvaluationMethods[k]));
-    PlotSeries dots = makeSeries("", colors[k]);
+    io::PlotSeries dots = makeSeries("", colors[k]);
     std::size_t j = 0;
     std::vector<double> errors;
     for (const FragmentEvaluation& e : evaluations) {
@@ -577,7 +577,7 @@ Status writeEvaluationPlots(std::span<const FragmentEvaluation> evaluations,
     errorSeries.push_back(std::move(dots));
   }
   errorSeries.push_back(std::move(medians));
-  return savePng(plotChart(errorAxes, errorSeries), directory / "error.png");
+  return io::savePng(io::plotChart(errorAxes, errorSeries), directory / "error.png");
 }
 
-}  // namespace shapedb::io
+}  // namespace shapedb::bench
