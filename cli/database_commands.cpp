@@ -179,83 +179,94 @@ void printCheck(const io::IntegrityReport& report) {
                 d.part.c_str());
 }
 
-int runInfo(const InfoOptions& o) {
-  auto store = io::Store::open(o.path);
-  if (!store) {
-    printError(store.error().message);
-    return kExitInputError;
-  }
-  auto entries = store->entries();
-  auto failures = store->failures();
-  if (!entries || !failures) {
-    printError((entries ? failures.error() : entries.error()).message);
-    return kExitInputError;
-  }
-  std::optional<io::IntegrityReport> check;
-  if (o.check) {
-    auto report = store->check();
-    if (!report) {
-      printError(report.error().message);
-      return kExitInputError;
-    }
-    check = std::move(report).value();
-  }
-  // A damaged file is reported in full, then fails the command.
-  const int exitCode = !check || check->ok() ? kExitOk : kExitInputError;
+/// What info reports of a database file.
+struct InfoSummary {
+  std::string status, created;
+  std::size_t entries = 0;
+  std::vector<io::FailureRecord> failures;
   std::map<std::string, std::size_t> perFamily;
+  double meanNodes = 0.0, meanTets = 0.0;
+  std::uintmax_t bytes = 0;  ///< the file and its write-ahead log
+  double buildSeconds = 0.0;
+  io::BuildParameters parameters;
+  std::optional<io::IntegrityReport> check;  ///< with --check
+};
+
+Result<InfoSummary> summarizeDatabase(const std::string& path, bool check) {
+  auto store = io::Store::open(path);
+  if (!store) return store.error();
+  auto entries = store->entries();
+  if (!entries) return entries.error();
+  auto failures = store->failures();
+  if (!failures) return failures.error();
+  InfoSummary s;
+  if (check) {
+    auto report = store->check();
+    if (!report) return report.error();
+    s.check = std::move(report).value();
+  }
+  s.entries = entries->size();
+  s.failures = std::move(failures).value();
   std::size_t nodes = 0, tets = 0;
   for (const io::EntryRecord& r : *entries) {
-    ++perFamily[volume::toString(r.family)];
+    ++s.perFamily[volume::toString(r.family)];
     nodes += r.nodes;
     tets += r.tets;
   }
-  std::error_code ec;
-  std::uintmax_t bytes = std::filesystem::file_size(o.path, ec);
-  const std::filesystem::path wal = o.path + "-wal";
-  if (std::filesystem::exists(wal, ec)) bytes += std::filesystem::file_size(wal, ec);
-  const double buildSeconds = std::stod(store->meta("build_seconds").value_or("0"));
-  const std::string status = store->meta("status").value_or("unknown");
-  const std::size_t n = entries->size();
-
-  nlohmann::json families = nlohmann::json::object();
-  for (const auto& [family, count] : perFamily)
-    families[family] = count;
-  nlohmann::json failed = nlohmann::json::array();
-  for (const io::FailureRecord& f : *failures)
-    failed.push_back({{"name", f.name}, {"message", f.message}});
-  if (o.json) {
-    nlohmann::json out = {{"file", o.path},
-                          {"schema_version", io::kSchemaVersion},
-                          {"status", status},
-                          {"created", store->meta("created").value_or("")},
-                          {"entries", n},
-                          {"families", families},
-                          {"failures", failed},
-                          {"parameters", nlohmann::json::parse(io::toJson(store->parameters()))},
-                          {"size_bytes", bytes},
-                          {"bytes_per_entry", n ? static_cast<double>(bytes) / static_cast<double>(n) : 0.0},
-                          {"build_seconds", buildSeconds},
-                          {"mean_nodes", n ? static_cast<double>(nodes) / static_cast<double>(n) : 0.0},
-                          {"mean_tets", n ? static_cast<double>(tets) / static_cast<double>(n) : 0.0}};
-    if (check) out["check"] = checkJson(*check);
-    std::printf("%s\n", out.dump(2).c_str());
-    return exitCode;
+  if (s.entries > 0) {
+    s.meanNodes = static_cast<double>(nodes) / static_cast<double>(s.entries);
+    s.meanTets = static_cast<double>(tets) / static_cast<double>(s.entries);
   }
-  const io::BuildParameters& p = store->parameters();
-  std::printf("%s: shapedb database, schema %d, %s, created %s\n", o.path.c_str(), io::kSchemaVersion,
-              status.c_str(), store->meta("created").value_or("?").c_str());
-  std::printf("entries: %zu", n);
-  for (const auto& [family, count] : perFamily)
+  std::error_code ec;
+  s.bytes = std::filesystem::file_size(path, ec);
+  const std::filesystem::path wal = path + "-wal";
+  if (std::filesystem::exists(wal, ec)) s.bytes += std::filesystem::file_size(wal, ec);
+  s.buildSeconds = std::stod(store->meta("build_seconds").value_or("0"));
+  s.status = store->meta("status").value_or("unknown");
+  s.created = store->meta("created").value_or("");
+  s.parameters = store->parameters();
+  return s;
+}
+
+double bytesPerEntry(const InfoSummary& s) {
+  return s.entries ? static_cast<double>(s.bytes) / static_cast<double>(s.entries) : 0.0;
+}
+
+nlohmann::json infoJson(const std::string& path, const InfoSummary& s) {
+  nlohmann::json failed = nlohmann::json::array();
+  for (const io::FailureRecord& f : s.failures)
+    failed.push_back({{"name", f.name}, {"message", f.message}});
+  nlohmann::json out = {{"file", path},
+                        {"schema_version", io::kSchemaVersion},
+                        {"status", s.status},
+                        {"created", s.created},
+                        {"entries", s.entries},
+                        {"families", s.perFamily},
+                        {"failures", failed},
+                        {"parameters", nlohmann::json::parse(io::toJson(s.parameters))},
+                        {"size_bytes", s.bytes},
+                        {"bytes_per_entry", bytesPerEntry(s)},
+                        {"build_seconds", s.buildSeconds},
+                        {"mean_nodes", s.meanNodes},
+                        {"mean_tets", s.meanTets}};
+  if (s.check) out["check"] = checkJson(*s.check);
+  return out;
+}
+
+void printInfo(const std::string& path, const InfoSummary& s) {
+  const io::BuildParameters& p = s.parameters;
+  std::printf("%s: shapedb database, schema %d, %s, created %s\n", path.c_str(), io::kSchemaVersion,
+              s.status.c_str(), s.created.empty() ? "?" : s.created.c_str());
+  std::printf("entries: %zu", s.entries);
+  for (const auto& [family, count] : s.perFamily)
     std::printf("  %s %zu", family.c_str(), count);
-  std::printf("\nfailed: %zu\n", failures->size());
-  for (std::size_t i = 0; i < failures->size() && i < 10; ++i)
-    std::printf("  %s: %s\n", (*failures)[i].name.c_str(), (*failures)[i].message.c_str());
-  std::printf("size on disk: %.1f MiB (%.1f KiB per entry)\n", static_cast<double>(bytes) / 1048576.0,
-              n ? static_cast<double>(bytes) / 1024.0 / static_cast<double>(n) : 0.0);
-  std::printf("build time: %s\n", formatDuration(buildSeconds).c_str());
-  std::printf("tet meshes: %.0f nodes, %.0f tets on average\n",
-              n ? static_cast<double>(nodes) / static_cast<double>(n) : 0.0,
-              n ? static_cast<double>(tets) / static_cast<double>(n) : 0.0);
+  std::printf("\nfailed: %zu\n", s.failures.size());
+  for (std::size_t i = 0; i < s.failures.size() && i < 10; ++i)
+    std::printf("  %s: %s\n", s.failures[i].name.c_str(), s.failures[i].message.c_str());
+  std::printf("size on disk: %.1f MiB (%.1f KiB per entry)\n", static_cast<double>(s.bytes) / 1048576.0,
+              bytesPerEntry(s) / 1024.0);
+  std::printf("build time: %s\n", formatDuration(s.buildSeconds).c_str());
+  std::printf("tet meshes: %.0f nodes, %.0f tets on average\n", s.meanNodes, s.meanTets);
   std::printf(
       "parameters: catalog of %zu, descriptor grid %d (%s sampling), %d modes at Poisson ratio %.3g\n"
       "  on %s tets, TetGen q%.3g with tets ≤ 1/%.0f of the volume, collision ≤ %d shapes,\n"
@@ -265,8 +276,21 @@ int runInfo(const InfoOptions& o) {
       p.entry.tetgen.maxRadiusEdgeRatio,
       p.entry.tetgen.maxVolumeFraction > 0 ? 1.0 / p.entry.tetgen.maxVolumeFraction : 0.0,
       p.entry.collision.maxShapes, p.entry.damping.alpha, p.entry.damping.beta);
-  if (check) printCheck(*check);
-  return exitCode;
+  if (s.check) printCheck(*s.check);
+}
+
+int runInfo(const InfoOptions& o) {
+  Result<InfoSummary> summary = summarizeDatabase(o.path, o.check);
+  if (!summary) {
+    printError(summary.error().message);
+    return kExitInputError;
+  }
+  if (o.json)
+    std::printf("%s\n", infoJson(o.path, *summary).dump(2).c_str());
+  else
+    printInfo(o.path, *summary);
+  // A damaged file is reported in full, then fails the command.
+  return !summary->check || summary->check->ok() ? kExitOk : kExitInputError;
 }
 
 struct AddOptions {

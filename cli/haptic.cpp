@@ -129,28 +129,56 @@ haptics::TrajectoryDevice defaultSweep(const std::vector<haptics::SceneObject>& 
   return haptics::TrajectoryDevice::sweep(lo, hi, lanes, speed);
 }
 
+// The scene: a folder of meshes, or a mesh broken by --fracture (its fragments where the fracture left
+// them: the broken object, in its own frame).
+Result<std::vector<haptics::SceneObject>> loadHapticScene(const HapticCommandOptions& o) {
+  if (!o.scene.empty()) return haptics::loadScene(o.scene, o.load.options);
+  Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.load, o.fracture);
+  if (!pieces) return pieces.error();
+  std::vector<haptics::SceneObject> scene;
+  for (std::size_t i = 0; i < pieces->fragments.size(); ++i)
+    scene.push_back({volume::fragmentName(i), std::move(pieces->fragments[i])});
+  std::fprintf(stderr, "haptic: %s broken into %zu fragments\n", o.fractureMesh.c_str(), scene.size());
+  return scene;
+}
+
+// The device: a recorded trajectory, or the default sweep over the scene.
+Result<haptics::TrajectoryDevice> hapticDevice(const HapticCommandOptions& o,
+                                               const std::vector<haptics::SceneObject>& scene) {
+  if (o.trajectory.empty()) return defaultSweep(scene, o.speed);
+  return haptics::TrajectoryDevice::fromCsv(o.trajectory);
+}
+
+void printHapticSummary(const HapticCommandOptions& o, const haptics::LoopReport& r) {
+  std::printf(
+      "ticks %zu at %.1f Hz (asked %.0f), tick µs p50 %.2f p99 %.2f max %.2f, deadline misses %zu%s\n",
+      r.ticks, r.achievedRateHz, o.loop.rateHz, r.tickMicros.p50, r.tickMicros.p99, r.tickMicros.max,
+      r.deadlineMisses, o.simulate ? " (simulated clock)" : "");
+  std::printf("objects %zu: %zu augmented, %zu failed, %zu pending; augmentation ms p50 %.2f p99 %.2f\n",
+              r.objects.size(), r.objectsAugmented, r.objectsFailed, r.objectsPending,
+              r.augmentationMillis.p50, r.augmentationMillis.p99);
+  if (o.enrich)
+    std::printf(
+        "learned: %zu objects swapped to their exact data (ms from entering reach p50 %.0f, max %.0f), "
+        "%zu still computing\n",
+        r.upgrades, r.upgradeMillis.p50, r.upgradeMillis.max, r.upgradesPending);
+  std::printf("contact in %zu ticks, largest force %.3g N; report: %s\n", r.contactTicks, r.maxForce,
+              o.report.c_str());
+  for (const haptics::ObjectOutcome& object : r.objects)
+    if (object.state == haptics::ObjectOutcome::State::kFailed)
+      std::fprintf(stderr, "haptic: %s: not augmented: %s\n", object.name.c_str(), object.error.c_str());
+    else if (!object.upgradeError.empty())
+      std::fprintf(stderr, "haptic: %s: not learned: %s\n", object.name.c_str(), object.upgradeError.c_str());
+}
+
 int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
-
   if (o.scene.empty() == o.fractureMesh.empty()) {
     printError("give a SCENE_DIR or --fracture MESH --pieces N, not both");
     return kExitUsage;
   }
-  Result<std::vector<haptics::SceneObject>> scene = std::vector<haptics::SceneObject>{};
-  if (!o.scene.empty()) {
-    scene = haptics::loadScene(o.scene, o.load.options);
-  } else {
-    // The fragments stay where the fracture left them: the broken object, in its own frame.
-    Result<volume::FractureResult> pieces = fractureMeshFile(o.fractureMesh, o.load, o.fracture);
-    if (!pieces) {
-      scene = pieces.error();
-    } else {
-      for (std::size_t i = 0; i < pieces->fragments.size(); ++i)
-        scene->push_back({volume::fragmentName(i), std::move(pieces->fragments[i])});
-      std::fprintf(stderr, "haptic: %s broken into %zu fragments\n", o.fractureMesh.c_str(), scene->size());
-    }
-  }
+  Result<std::vector<haptics::SceneObject>> scene = loadHapticScene(o);
   if (!scene) {
     printError(scene.error().message);
     return kExitInputError;
@@ -162,16 +190,10 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
     printError(db.error().message);
     return kExitInputError;
   }
-  std::optional<haptics::TrajectoryDevice> device;
-  if (o.trajectory.empty()) {
-    device = defaultSweep(*scene, o.speed);
-  } else {
-    auto played = haptics::TrajectoryDevice::fromCsv(o.trajectory);
-    if (!played) {
-      printError(played.error().message);
-      return kExitInputError;
-    }
-    device = std::move(*played);
+  Result<haptics::TrajectoryDevice> device = hapticDevice(o, *scene);
+  if (!device) {
+    printError(device.error().message);
+    return kExitInputError;
   }
 
   io::QueryOptions query;
@@ -195,41 +217,19 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
                o.loop.rateHz, o.seconds, o.simulate ? "simulated" : "steady", o.loop.workers,
                o.loop.workers == 1 ? "" : "s");
   const haptics::LoopReport r = o.simulate ? (*loop)->simulate(o.seconds) : (*loop)->run(o.seconds);
-
   if (enricher && enricher->pending() > 0)
     std::fprintf(
         stderr,
         "haptic: %zu objects still being learned: the one under way is finished and kept, the others "
         "are left for another run (or shapedb enrich)\n",
         enricher->pending());
-  const nlohmann::json j = reportJson(o, r, *material);
-  {
-    std::ofstream out(o.report);
-    out << j.dump(2) << '\n';
-    if (!out) {
-      printError(o.report + ": cannot write the report");
-      return kExitInputError;
-    }
+  std::ofstream out(o.report);
+  out << reportJson(o, r, *material).dump(2) << '\n';
+  if (!out) {
+    printError(o.report + ": cannot write the report");
+    return kExitInputError;
   }
-  std::printf(
-      "ticks %zu at %.1f Hz (asked %.0f), tick µs p50 %.2f p99 %.2f max %.2f, deadline misses %zu%s\n",
-      r.ticks, r.achievedRateHz, o.loop.rateHz, r.tickMicros.p50, r.tickMicros.p99, r.tickMicros.max,
-      r.deadlineMisses, o.simulate ? " (simulated clock)" : "");
-  std::printf("objects %zu: %zu augmented, %zu failed, %zu pending; augmentation ms p50 %.2f p99 %.2f\n",
-              r.objects.size(), r.objectsAugmented, r.objectsFailed, r.objectsPending,
-              r.augmentationMillis.p50, r.augmentationMillis.p99);
-  if (o.enrich)
-    std::printf(
-        "learned: %zu objects swapped to their exact data (ms from entering reach p50 %.0f, max %.0f), "
-        "%zu still computing\n",
-        r.upgrades, r.upgradeMillis.p50, r.upgradeMillis.max, r.upgradesPending);
-  std::printf("contact in %zu ticks, largest force %.3g N; report: %s\n", r.contactTicks, r.maxForce,
-              o.report.c_str());
-  for (const haptics::ObjectOutcome& object : r.objects)
-    if (object.state == haptics::ObjectOutcome::State::kFailed)
-      std::fprintf(stderr, "haptic: %s: not augmented: %s\n", object.name.c_str(), object.error.c_str());
-    else if (!object.upgradeError.empty())
-      std::fprintf(stderr, "haptic: %s: not learned: %s\n", object.name.c_str(), object.upgradeError.c_str());
+  printHapticSummary(o, r);
   return kExitOk;
 }
 

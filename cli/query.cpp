@@ -384,6 +384,66 @@ io::QueryOptions queryOptionsOf(const QueryCommandOptions& o) {
   return options;
 }
 
+/// The files from `next` on, loaded a batch at a time: up to 256 files or 4 million triangles, so that a
+/// folder of large scans is never in memory all at once. A file that cannot be read is reported and
+/// skipped (status: kExitInputError). batch[b]'s mesh is meshes[b] (moved out of its LoadedMesh).
+void loadBatch(const QueryCommandOptions& o, std::size_t& next, std::vector<LoadedFile>& batch,
+               std::vector<core::TriangleMesh>& meshes, int& status) {
+  constexpr std::size_t kBatchFiles = 256, kBatchTriangles = 4'000'000;
+  std::size_t triangles = 0;
+  while (next < o.meshes.size() && batch.size() < kBatchFiles && triangles < kBatchTriangles) {
+    LoadedFile f{next, o.meshes[next], {}, {}};
+    ++next;
+    auto loaded = loadMeshFile(f.file, o.load, &f.repaired);
+    if (!loaded) {
+      printError(loaded.error().message + flagHint(loaded.error()));
+      status = kExitInputError;
+      continue;
+    }
+    triangles += loaded->mesh.triangleCount();
+    meshes.push_back(std::move(loaded->mesh));
+    f.loaded = std::move(loaded).value();
+    batch.push_back(std::move(f));
+  }
+}
+
+/// With --enrich: the mesh handed to the enricher, unless its answer is predicted to be good enough
+/// already (--enrich-above) or there is no solid to learn (an approximate answer's open surface cannot
+/// be tetrahedralized).
+void submitToLearn(const QueryCommandOptions& o, io::Enricher& enricher, const LoadedFile& f,
+                   const core::TriangleMesh& mesh, const io::QueryResult& r, std::size_t jsonIndex,
+                   std::vector<PendingLearn>& pending) {
+  if (r.massProperties.isApproximate) {
+    std::fprintf(stderr, "shapedb: %s: not learned: it bounds no solid (answered approximately)\n",
+                 f.file.c_str());
+    return;
+  }
+  if (o.enrichAbove > 0.0 && r.predictedFrequencyError && *r.predictedFrequencyError <= o.enrichAbove) {
+    if (!o.json)
+      std::fprintf(stderr, "shapedb: %s: not learned: predicted error %.1f %% is within --enrich-above\n",
+                   f.file.c_str(), 100.0 * *r.predictedFrequencyError);
+    return;
+  }
+  pending.push_back({f.file, mesh, jsonIndex,
+                     enricher.submit({std::filesystem::path(f.file).filename().string(), f.file, mesh})});
+}
+
+/// One answer out: the files beside it (--export-obj, --png), then JSON, a table row or text.
+Status reportAnswer(const QueryCommandOptions& o, const LoadedFile& f, const core::TriangleMesh& mesh,
+                    const io::QueryResult& r, nlohmann::json& queries) {
+  if (!o.exportDir.empty())
+    if (Status st = exportObj(o.exportDir, std::filesystem::path(f.file).stem().string(), r); !st) return st;
+  if (!o.png.empty())
+    if (Status st = renderPng(pngPath(o.png, f.index, o.meshes.size()), mesh, r); !st) return st;
+  if (o.json)
+    queries.push_back(queryJson(f.file, f.loaded, mesh, f.repaired, r, o.descriptor));
+  else if (o.table)
+    printTableRow(f.file, r);
+  else
+    printText(f.file, mesh, r, o.timing);
+  return Ok{};
+}
+
 int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   io::QueryOptions options = queryOptionsOf(o);
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
@@ -407,70 +467,24 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   nlohmann::json queries = nlohmann::json::array();
   int status = kExitOk;
   if (o.table && !o.json) printTableHeader();
-  // The files are loaded and answered a batch at a time (Database::queryMany spreads a batch's queries
-  // over the cores) and printed in the order given. A batch holds up to 256 files or 4 million
-  // triangles, so that a folder of large scans is never in memory all at once.
-  constexpr std::size_t kBatchFiles = 256, kBatchTriangles = 4'000'000;
+  // A batch at a time, its queries spread over the cores (Database::queryMany), printed in the order given.
   for (std::size_t next = 0; next < o.meshes.size();) {
     std::vector<LoadedFile> batch;
-    std::vector<core::TriangleMesh> meshes;  // batch[b]'s mesh is meshes[b] (moved out of its LoadedMesh)
-    std::size_t triangles = 0;
-    while (next < o.meshes.size() && batch.size() < kBatchFiles && triangles < kBatchTriangles) {
-      LoadedFile f{next, o.meshes[next], {}, {}};
-      ++next;
-      auto loaded = loadMeshFile(f.file, o.load, &f.repaired);
-      if (!loaded) {
-        printError(loaded.error().message + flagHint(loaded.error()));
-        status = kExitInputError;
-        continue;
-      }
-      triangles += loaded->mesh.triangleCount();
-      meshes.push_back(std::move(loaded->mesh));
-      f.loaded = std::move(loaded).value();
-      batch.push_back(std::move(f));
-    }
+    std::vector<core::TriangleMesh> meshes;
+    loadBatch(o, next, batch, meshes, status);
     const std::vector<Result<io::QueryResult>> results = db->queryMany(meshes, options);
     for (std::size_t b = 0; b < batch.size(); ++b) {
-      const LoadedFile& f = batch[b];
-      const core::TriangleMesh& mesh = meshes[b];
-      const Result<io::QueryResult>& result = results[b];
-      if (!result) {
-        printError(f.file + ": " + result.error().message + approximateHint(result.error()) +
-                   flagHint(result.error()));
+      if (!results[b]) {
+        const Error& e = results[b].error();
+        printError(batch[b].file + ": " + e.message + approximateHint(e) + flagHint(e));
         status = kExitInputError;
         continue;
       }
-      // Learned unless its answer is predicted to be good enough already (--enrich-above), or there is
-      // no solid to learn (an approximate answer's open surface cannot be tetrahedralized).
-      const bool learn = enricher && !result->massProperties.isApproximate &&
-                         (o.enrichAbove <= 0.0 || !result->predictedFrequencyError ||
-                          *result->predictedFrequencyError > o.enrichAbove);
-      if (enricher && result->massProperties.isApproximate)
-        std::fprintf(stderr, "shapedb: %s: not learned: it bounds no solid (answered approximately)\n",
-                     f.file.c_str());
-      if (learn)
-        pending.push_back(
-            {f.file, mesh, queries.size(),
-             enricher->submit({std::filesystem::path(f.file).filename().string(), f.file, mesh})});
-      else if (enricher && !o.json && !result->massProperties.isApproximate)
-        std::fprintf(stderr, "shapedb: %s: not learned: predicted error %.1f %% is within --enrich-above\n",
-                     f.file.c_str(), 100.0 * *result->predictedFrequencyError);
-      if (!o.exportDir.empty())
-        if (Status st = exportObj(o.exportDir, std::filesystem::path(f.file).stem().string(), *result); !st) {
-          printError(st.error().message);
-          return kExitInputError;
-        }
-      if (!o.png.empty())
-        if (Status st = renderPng(pngPath(o.png, f.index, o.meshes.size()), mesh, *result); !st) {
-          printError(st.error().message);
-          return kExitInputError;
-        }
-      if (o.json)
-        queries.push_back(queryJson(f.file, f.loaded, mesh, f.repaired, *result, o.descriptor));
-      else if (o.table)
-        printTableRow(f.file, *result);
-      else
-        printText(f.file, mesh, *result, o.timing);
+      if (enricher) submitToLearn(o, *enricher, batch[b], meshes[b], *results[b], queries.size(), pending);
+      if (Status st = reportAnswer(o, batch[b], meshes[b], *results[b], queries); !st) {
+        printError(st.error().message);
+        return kExitInputError;
+      }
     }
   }
   if (enricher)
