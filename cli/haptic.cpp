@@ -113,22 +113,6 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
           {"objects", std::move(objects)}};
 }
 
-/// The default proxy path: back and forth through the scene's bounding box at mid height, one lane per
-/// typical object width, at `speed` m/s (as far as the run goes).
-haptics::TrajectoryDevice defaultSweep(const std::vector<haptics::SceneObject>& objects, double speed) {
-  core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  std::vector<double> widths;
-  for (const haptics::SceneObject& object : objects) {
-    const core::Bounds b = core::computeBounds(object.mesh);
-    lo = lo.cwiseMin(b.min);
-    hi = hi.cwiseMax(b.max);
-    widths.push_back((b.max - b.min).head<2>().maxCoeff());
-  }
-  const double width = std::max(core::median(widths), 1e-9);
-  const int lanes = std::clamp(static_cast<int>(std::ceil((hi.y() - lo.y()) / width)), 1, 200);
-  return haptics::TrajectoryDevice::sweep(lo, hi, lanes, speed);
-}
-
 // The scene: a folder of meshes, or a mesh broken by --fracture (its fragments where the fracture left
 // them: the broken object, in its own frame).
 Result<std::vector<haptics::SceneObject>> loadHapticScene(const HapticCommandOptions& o) {
@@ -145,7 +129,7 @@ Result<std::vector<haptics::SceneObject>> loadHapticScene(const HapticCommandOpt
 // The device: a recorded trajectory, or the default sweep over the scene.
 Result<haptics::TrajectoryDevice> hapticDevice(const HapticCommandOptions& o,
                                                const std::vector<haptics::SceneObject>& scene) {
-  if (o.trajectory.empty()) return defaultSweep(scene, o.speed);
+  if (o.trajectory.empty()) return haptics::sweepThrough(scene, o.speed);
   return haptics::TrajectoryDevice::fromCsv(o.trajectory);
 }
 

@@ -31,18 +31,6 @@ struct SoundCommandOptions {
   core::ImpactSoundOptions sound;
 };
 
-/// Area-weighted normals per vertex, outward.
-std::vector<core::Vec3> vertexNormals(const core::TriangleMesh& mesh) {
-  std::vector<core::Vec3> normals(mesh.vertices.size(), core::Vec3::Zero());
-  for (const auto& t : mesh.triangles) {
-    const core::Vec3 n =
-        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
-    for (std::uint32_t v : t)
-      normals[v] += n;
-  }
-  return normals;
-}
-
 int runSound(const SoundCommandOptions& o, const CLI::App& app) {
   const std::optional<core::Material> material = resolveMaterial(o.material, app);
   if (!material) return kExitUsage;
@@ -70,23 +58,18 @@ int runSound(const SoundCommandOptions& o, const CLI::App& app) {
     return kExitInputError;
   }
 
-  // The impact: the vertex nearest --impact, or by default the one farthest from the centre of mass (a
-  // corner or a tip, which excites most modes); struck inward along its normal.
+  // The impact: the vertex nearest --impact, or by default the one farthest from the centre of mass.
   const core::TriangleMesh& mesh = loaded->mesh;
-  const core::Vec3 target = o.impact.size() == 3 ? core::Vec3(o.impact[0], o.impact[1], o.impact[2])
-                                                 : r->massProperties.centerOfMass;
-  std::size_t vertex = 0;
-  double best = o.impact.size() == 3 ? std::numeric_limits<double>::infinity() : -1.0;
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-    const double d = (mesh.vertices[v] - target).squaredNorm();
-    if (o.impact.size() == 3 ? d < best : d > best) {
-      best = d;
-      vertex = v;
-    }
+  std::optional<core::Vec3> near;
+  if (o.impact.size() == 3) near = core::Vec3(o.impact[0], o.impact[1], o.impact[2]);
+  Result<core::ImpactPoint> impact = core::chooseImpact(mesh, r->massProperties.centerOfMass, near);
+  if (!impact) {
+    printError(o.mesh + ": " + impact.error().message);
+    return kExitInputError;
   }
-  const core::Vec3 normal = vertexNormals(mesh)[vertex];
+  const std::size_t vertex = impact->vertex;
   Result<core::ImpactSound> sound =
-      core::synthesizeImpact(*r->physics, r->link.locations[vertex], -normal, o.sound);
+      core::synthesizeImpact(*r->physics, r->link.locations[vertex], impact->direction, o.sound);
   if (!sound) {
     printError(o.mesh + ": " + sound.error().message);
     return kExitInputError;

@@ -1,11 +1,33 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
 #include <shapedb/core/sound.h>
 
 namespace shapedb::core {
+
+Result<ImpactPoint> chooseImpact(const TriangleMesh& mesh, const Vec3& center,
+                                 const std::optional<Vec3>& near) {
+  if (mesh.vertices.empty()) return Error{ErrorCode::kEmptyMesh, "mesh has no vertices"};
+  const Vec3 target = near.value_or(center);
+  ImpactPoint out;
+  double best = near ? std::numeric_limits<double>::infinity() : -1.0;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const double d = (mesh.vertices[v] - target).squaredNorm();
+    if (near ? d < best : d > best) {
+      best = d;
+      out.vertex = v;
+    }
+  }
+  Vec3 normal = Vec3::Zero();
+  for (const auto& t : mesh.triangles)
+    if (t[0] == out.vertex || t[1] == out.vertex || t[2] == out.vertex)
+      normal += (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+  if (normal.squaredNorm() > 0.0) out.direction = -normal.normalized();
+  return out;
+}
 
 Result<ImpactSound> synthesizeImpact(const AdaptedPhysics& physics, const TetLocation& at,
                                      const Vec3& direction, const ImpactSoundOptions& options) {

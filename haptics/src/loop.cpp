@@ -19,6 +19,20 @@
 
 namespace shapedb::haptics {
 
+TrajectoryDevice sweepThrough(const std::vector<SceneObject>& objects, double speed) {
+  core::Vec3 lo = core::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<double> widths;
+  for (const SceneObject& object : objects) {
+    const core::Bounds b = core::computeBounds(object.mesh);
+    lo = lo.cwiseMin(b.min);
+    hi = hi.cwiseMax(b.max);
+    widths.push_back((b.max - b.min).head<2>().maxCoeff());
+  }
+  const double width = std::max(core::median(widths), 1e-9);
+  const int lanes = std::clamp(static_cast<int>(std::ceil((hi.y() - lo.y()) / width)), 1, 200);
+  return TrajectoryDevice::sweep(lo, hi, lanes, speed);
+}
+
 using core::Vec3;
 using State = ObjectOutcome::State;
 using Clock = std::chrono::steady_clock;

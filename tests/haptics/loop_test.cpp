@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <shapedb/core/primitives.h>
 #include <shapedb/haptics/loop.h>
 
 #include "synthetic_scene.h"
@@ -27,6 +28,33 @@ TrajectoryDevice sweepAlongRow(double length, double seconds, double dip, double
 
 AugmentFunction synthetic() {
   return [](const SceneObject& object) { return test::augmentBox(object); };
+}
+
+// The default sweep over a scene covers the objects' bounding box, a lane per typical object width.
+TEST(HapticLoop, TheDefaultSweepCrossesTheSceneALanePerObjectWidth) {
+  // Three 1 m cubes spread over 6 m along y: lanes of the median width (1 m), six of them.
+  std::vector<SceneObject> scene;
+  for (double y : {0.5, 3.0, 5.5}) {
+    core::TriangleMesh cube = core::makeBox({1.0, 1.0, 1.0});
+    for (Vec3& p : cube.vertices)
+      p += Vec3(0.5, y, 0.5);
+    scene.push_back({"cube", cube});
+  }
+  TrajectoryDevice sweep = sweepThrough(scene, 2.0);
+  EXPECT_LT((sweep.position(0.0) - Vec3(0.0, 0.0, 0.5)).norm(), 1e-12);
+  EXPECT_LT((sweep.position(1e6) - Vec3(0.0, 6.0, 0.5)).norm(), 1e-12);  // six lanes: ends at x's start
+  // Every keyframe inside the box, at mid height; lanes 1.2 m apart (six over 6 m: five gaps).
+  double lastY = 0.0;
+  for (const TrajectoryDevice::Keyframe& k : sweep.keyframes()) {
+    EXPECT_GE(k.position.x(), -1e-12);
+    EXPECT_LE(k.position.x(), 1.0 + 1e-12);
+    EXPECT_NEAR(k.position.z(), 0.5, 1e-12);
+    if (k.position.y() > lastY + 1e-9) {
+      EXPECT_NEAR(k.position.y() - lastY, 1.2, 1e-9);
+      lastY = k.position.y();
+    }
+  }
+  EXPECT_NEAR(lastY, 6.0, 1e-9);
 }
 
 TEST(HapticLoop, SimulatedRunsAreDeterministicToTheBit) {

@@ -2,6 +2,7 @@
 // Modal sound synthesis (the paper's first application): the sound of an impact on an object from its
 // adapted modes. Each mode rings as a damped sinusoid at its frequency, excited by the impulse through
 // the linking weights at the impact point (van den Doel & Pai; O'Brien et al.).
+#include <optional>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -9,6 +10,7 @@
 #include <shapedb/core/adapt.h>
 #include <shapedb/core/result.h>
 #include <shapedb/core/spatial.h>
+#include <shapedb/core/triangle_mesh.h>
 #include <shapedb/core/types.h>
 
 namespace shapedb::core {
@@ -31,6 +33,18 @@ struct ImpactSound {
   Eigen::VectorXd gains;          ///< theirs, gᵢ (m/s per N·s)
   double scale = 0.0;             ///< samples = scale · (the physical modal velocity sum, m/s per N·s)
 };
+
+/// Where an impact strikes a surface: a vertex, and the direction of the blow, its inward unit normal
+/// (the area-weighted normal of its triangles, reversed; zero where those cancel).
+struct ImpactPoint {
+  std::size_t vertex = 0;
+  Vec3 direction = Vec3::Zero();
+};
+
+/// The vertex of `mesh` nearest `near`, or without it the one farthest from `center` (the centre of mass,
+/// say: a corner or a tip, which excites most modes). Errors: kEmptyMesh (no vertex).
+Result<ImpactPoint> chooseImpact(const TriangleMesh& mesh, const Vec3& center,
+                                 const std::optional<Vec3>& near = std::nullopt);
 
 /// The sound of a unit impulse along `direction` (normalized here) at `at`, a point located in the
 /// adapted tets (a vertex's SurfaceLink location). Errors: kInvalidArgument (options, a zero

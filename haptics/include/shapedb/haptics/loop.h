@@ -33,6 +33,11 @@ struct SceneObject {
   core::TriangleMesh mesh;
 };
 
+/// The default proxy path over a scene: TrajectoryDevice::sweep through the objects' bounding box at mid
+/// height, one lane per typical object width (the median of their widths across x and y; at most 200
+/// lanes), at `speed` m/s. Precondition: at least one object with a vertex, speed > 0.
+TrajectoryDevice sweepThrough(const std::vector<SceneObject>& objects, double speed);
+
 struct AugmentedObject;
 
 /// Better data to come for an object already augmented: its exact data, say, being computed in the
