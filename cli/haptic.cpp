@@ -106,6 +106,7 @@ nlohmann::json reportJson(const HapticCommandOptions& o, const haptics::LoopRepo
             {"stiffness_n_per_m", o.loop.stiffness},
             {"max_force_n", o.loop.maxForce},
             {"workers", o.loop.workers},
+            {"burst", o.loop.requestAllAtStart},
             {"descriptor", o.descriptor},
             {"correct", o.correct},
             {"enrich", o.enrich},
@@ -141,6 +142,10 @@ void printHapticSummary(const HapticCommandOptions& o, const haptics::LoopReport
   std::printf("objects %zu: %zu augmented, %zu failed, %zu pending; augmentation ms p50 %.2f p99 %.2f\n",
               r.objects.size(), r.objectsAugmented, r.objectsFailed, r.objectsPending,
               r.augmentationMillis.p50, r.augmentationMillis.p99);
+  if (o.loop.requestAllAtStart)
+    std::printf("burst: %zu objects requested at the first tick, %s within %.1f ms\n", r.objects.size(),
+                r.objectsAugmented == r.objects.size() ? "all augmented" : "not all augmented",
+                r.augmentationMillis.max);
   if (o.enrich)
     std::printf(
         "learned: %zu objects swapped to their exact data (ms from entering reach p50 %.0f, max %.0f), "
@@ -275,6 +280,10 @@ Command addHapticCommand(CLI::App& parent) {
   app->add_option("--workers", o->loop.workers, "Augmentation threads")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
+  app->add_flag("--burst", o->loop.requestAllAtStart,
+                "A fracture event: request every object at the first tick, wherever the proxy is (as a\n"
+                "fracture's fragments all need data at once); the report's augmentation max is the time to\n"
+                "all augmented. Use --workers to spread the burst over cores");
   app->add_option("--descriptor", o->descriptor, "Descriptor to match by")
       ->capture_default_str()
       ->check(CLI::IsMember({"moment", "voxel", "centroid-voxel"}));

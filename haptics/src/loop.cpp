@@ -387,7 +387,7 @@ Vec3 HapticLoop::Impl::tick(double seconds) {
       if (distance < live->reach + mOptions.proxyRadius) respond(slot, *live, proxy, force);
       continue;
     }
-    if (distance > slot.radius + mOptions.augmentationRadius) continue;
+    if (!mOptions.requestAllAtStart && distance > slot.radius + mOptions.augmentationRadius) continue;
     if (slot.state.load(std::memory_order_relaxed) != State::kUntouched) continue;
     // Post it: the workers pop in order; the semaphore wakes one (a futex, no lock).
     slot.requestedAt = seconds;

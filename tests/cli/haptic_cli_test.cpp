@@ -173,6 +173,22 @@ TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoo
   EXPECT_EQ(r["objects_failed"], 0);
   EXPECT_GT(r["contact_ticks"].get<int>(), 0);
 
+  // --burst: the fracture as an event, every fragment requested at the first tick (in real time, the
+  // proxy nowhere near most of them): all augmented, and the time to all of them reported.
+  const auto burstReport = dir / "burst.json";
+  test::ProcessResult burst =
+      test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), "--fracture", plate.string(), "--pieces", "6",
+                                     "--seed", "3", "--resolution", "48", "--burst", "--workers", "2",
+                                     "--seconds", "1", "--report", burstReport.string()});
+  ASSERT_EQ(burst.exitCode, 0) << burst.err;
+  const nlohmann::json b = readJson(burstReport);
+  EXPECT_TRUE(b["options"]["burst"].get<bool>());
+  EXPECT_EQ(b["objects_augmented"].get<std::size_t>(), files.size()) << burst.out;
+  EXPECT_NE(burst.out.find("burst: " + std::to_string(files.size()) +
+                           " objects requested at the first tick, all augmented within"),
+            std::string::npos)
+      << burst.out;
+
   test::ProcessResult both = test::runProcess(SHAPEDB_CLI, {"haptic", db.string(), out.string(), "--fracture",
                                                             plate.string(), "--report", report.string()});
   EXPECT_EQ(both.exitCode, 2);

@@ -30,6 +30,34 @@ AugmentFunction synthetic() {
   return [](const SceneObject& object) { return test::augmentBox(object); };
 }
 
+// A fracture event: every object requested at the first tick, however far the proxy is; without it, an
+// object is requested only when the proxy comes near.
+TEST(HapticLoop, AFractureEventRequestsEveryObjectAtTheFirstTick) {
+  const std::vector<SceneObject> objects = test::boxRow(5, 0.1, 1.0);
+  for (const bool burst : {false, true}) {
+    SCOPED_TRACE(burst ? "all at once" : "as the proxy comes near");
+    auto device = TrajectoryDevice::fromKeyframes({{0.0, Vec3(0.0, 10.0, 0.0)}});  // far from every box
+    ASSERT_TRUE(device.ok());
+    LoopOptions options;
+    options.requestAllAtStart = burst;
+    options.simulatedAugmentationSeconds = 0.02;
+    auto loop = HapticLoop::create(objects, *device, synthetic(), options);
+    ASSERT_TRUE(loop.ok()) << loop.error().message;
+    const LoopReport report = (*loop)->simulate(0.1);
+    EXPECT_EQ(report.objectsAugmented, burst ? objects.size() : 0u);
+    for (const ObjectOutcome& o : report.objects)
+      if (burst) {
+        EXPECT_EQ(o.state, ObjectOutcome::State::kReady) << o.name;
+        EXPECT_NEAR(o.augmentationSeconds, 0.02, 1e-9) << o.name;
+      } else {
+        EXPECT_EQ(o.state, ObjectOutcome::State::kUntouched) << o.name;
+      }
+    if (burst) {
+      EXPECT_NEAR(report.augmentationMillis.max, 20.0, 1e-6);
+    }
+  }
+}
+
 // The default sweep over a scene covers the objects' bounding box, a lane per typical object width.
 TEST(HapticLoop, TheDefaultSweepCrossesTheSceneALanePerObjectWidth) {
   // Three 1 m cubes spread over 6 m along y: lanes of the median width (1 m), six of them.

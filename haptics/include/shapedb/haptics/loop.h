@@ -83,6 +83,10 @@ struct LoopOptions {
   double simulatedAugmentationSeconds = 0.02;
   /// Keep the force of every tick in LoopReport::forces.
   bool recordForces = false;
+  /// A fracture event: every object is requested at the first tick, wherever the proxy is (the
+  /// augmentation radius is not used), as a fracture's fragments all need data at once. The report's
+  /// augmentationMillis.max is then the burst's time to all augmented.
+  bool requestAllAtStart = false;
 };
 
 struct Percentiles {
