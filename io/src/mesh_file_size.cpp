@@ -25,12 +25,21 @@ std::string lowercase(std::string s) {
   return s;
 }
 
-// PLY's header: "element vertex N" and "element face N", up to end_header (at most 64 KiB of it).
+// The file's first 64 KiB as lines: where a header's counts are, without reading a line of unbounded
+// length (a binary file may hold no newline at all).
+std::istringstream headerLines(std::ifstream& in) {
+  std::string head(64u << 10, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return std::istringstream(head);
+}
+
+// PLY's header: "element vertex N" and "element face N", up to end_header.
 MeshFileSize plyHeader(std::ifstream& in) {
   MeshFileSize size;
+  std::istringstream lines = headerLines(in);
   std::string line;
-  std::size_t read = 0;
-  while (std::getline(in, line) && (read += line.size() + 1) < (64u << 10)) {
+  while (std::getline(lines, line)) {
     std::istringstream words(line);
     std::string keyword, element;
     std::uint64_t count = 0;
@@ -44,11 +53,13 @@ MeshFileSize plyHeader(std::ifstream& in) {
   return size;
 }
 
-// OFF's counts: the first line of numbers after the keyword (comments and blank lines skipped).
+// OFF's counts: the first line that starts with two numbers (comments, blank lines and the keyword's line
+// skipped).
 MeshFileSize offHeader(std::ifstream& in) {
   MeshFileSize size;
+  std::istringstream lines = headerLines(in);
   std::string line;
-  for (int lines = 0; lines < 64 && std::getline(in, line); ++lines) {
+  while (std::getline(lines, line)) {
     const std::size_t start = line.find_first_not_of(" \t\r");
     if (start == std::string::npos || line[start] == '#') continue;
     std::istringstream words(line.substr(start));
@@ -155,11 +166,11 @@ std::optional<std::uint64_t> availableMemory() {
   const auto consider = [&least](std::uint64_t bytes) { least = least ? std::min(*least, bytes) : bytes; };
 
   std::ifstream meminfo("/proc/meminfo");
-  std::string key, unit;
-  std::uint64_t kib = 0;
-  while (meminfo >> key >> kib >> unit)
-    if (key == "MemAvailable:") {
-      consider(kib << 10);
+  for (std::string line; std::getline(meminfo, line);)
+    if (line.rfind("MemAvailable:", 0) == 0) {
+      std::istringstream words(line.substr(13));
+      std::uint64_t kib = 0;
+      if (words >> kib) consider(kib << 10);
       break;
     }
 
