@@ -367,6 +367,12 @@ TEST(MeshIo, AFileTooLargeForTheMemoryIsRefusedBeforeItIsRead) {
   ASSERT_TRUE(capped.ok());
   EXPECT_LE(capped->triangles, (2u << 20) / 4);
   EXPECT_NE(mustFail(dir / "corrupt.ply", {.memoryBudget = 1u << 30}).code, ErrorCode::kTooLarge);
+  // Nor is a file of 2 MiB without a line end read whole to find its header: nothing counted.
+  test::writeFile(dir / "one_line.ply", "ply" + std::string(2u << 20, 'x'));
+  const Result<MeshFileSize> none = estimateMeshFile(dir / "one_line.ply");
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->triangles, 0u);
+  EXPECT_EQ(mustFail(dir / "one_line.ply").code, ErrorCode::kParse);
 }
 
 // The memory available is the least of the system's, the control group's and the address-space limit's:
