@@ -128,7 +128,9 @@ int runDrop(const DropCommandOptions& o, const CLI::App& app) {
     printError(scene.error().message);
     return kExitInputError;
   }
-  auto db = io::Database::open(o.database);
+  io::Database::OpenOptions open;
+  open.descriptors = {io::QueryOptions{}.descriptor};  // the drop queries by the default descriptor
+  auto db = io::Database::open(o.database, open);
   if (!db) {
     printError(db.error().message);
     return kExitInputError;

@@ -174,6 +174,7 @@ int runHaptic(const HapticCommandOptions& o, const CLI::App& app) {
   }
   io::Database::OpenOptions open;
   open.learn = o.enrich;
+  open.descriptors = {*core::parseDescriptorKind(o.descriptor)};
   auto db = io::Database::open(o.database, open);
   if (!db) {
     printError(db.error().message);

@@ -452,6 +452,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
 
   io::Database::OpenOptions open;
   open.learn = o.enrich;
+  open.descriptors = {options.descriptor};  // the one index it searches: a third of the reading
   auto db = io::Database::open(o.database, open);
   if (!db) {
     printError(db.error().message);

@@ -39,7 +39,9 @@ int runSound(const SoundCommandOptions& o, const CLI::App& app) {
     printError(loaded.error().message);
     return kExitInputError;
   }
-  auto db = io::Database::open(o.database);
+  io::Database::OpenOptions open;
+  open.descriptors = {*core::parseDescriptorKind(o.descriptor)};
+  auto db = io::Database::open(o.database, open);
   if (!db) {
     printError(db.error().message);
     return kExitInputError;

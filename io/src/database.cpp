@@ -171,8 +171,10 @@ Result<Database> Database::open(const std::filesystem::path& path, const OpenOpt
     impl->byName.emplace(e.name, i);
     impl->nextId = std::max(impl->nextId, e.id + 1);
   }
-  for (core::DescriptorKind kind :
-       {core::DescriptorKind::kMoment, core::DescriptorKind::kVoxel, core::DescriptorKind::kCentroidVoxel}) {
+  if (options.descriptors.empty())
+    return Error{ErrorCode::kInvalidArgument, path.string() + ": no descriptor kind to index"};
+  for (core::DescriptorKind kind : options.descriptors) {
+    if (impl->indexes[static_cast<std::size_t>(kind)]) continue;  // named twice
     core::DescriptorOptions o = impl->store.parameters().entry.descriptor;
     o.kind = kind;
     core::IndexBuilder builder(o);
@@ -218,6 +220,9 @@ const EntryRecord* Database::entry(std::string_view name) const {
   const auto it = mImpl->learnedByName.find(std::string(name));
   return it == mImpl->learnedByName.end() ? nullptr : it->second;
 }
+bool Database::hasIndex(core::DescriptorKind kind) const {
+  return mImpl->indexes[static_cast<std::size_t>(kind)] != nullptr;
+}
 const core::LiveIndex& Database::index(core::DescriptorKind kind) const {
   return *mImpl->indexes[static_cast<std::size_t>(kind)];
 }
@@ -255,6 +260,7 @@ Result<core::EntryId> Database::learn(const std::string& name, const std::string
   }
   // The record first, then the descriptors: a search that finds the entry finds its record too.
   for (std::size_t k = 0; k < s.indexes.size(); ++k) {
+    if (!s.indexes[k]) continue;  // not opened: the file has its descriptors for another open
     const std::pair<core::EntryId, core::Descriptor> added(id, data.descriptors[k]);
     if (Status st = s.indexes[k]->add(std::span(&added, 1)); !st)
       return withContext(st.error(), s.store.path().string() + ": learned entry '" + name +
@@ -332,6 +338,10 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   const bool correcting = options.adapt && options.correct;
   if (correcting && (options.correctionCandidates < 1 || options.correctionCandidates > 100))
     return Error{ErrorCode::kInvalidArgument, "the geometry correction's candidates must be 1 to 100"};
+  if (!hasIndex(options.descriptor))
+    return Error{ErrorCode::kInvalidArgument, mImpl->store.path().string() + ": opened without its " +
+                                                  core::toString(options.descriptor) +
+                                                  " index (Database::OpenOptions::descriptors)"};
 
   Clock::time_point t = Clock::now();
   if (Status valid = core::validateMesh(mesh); !valid) return valid.error();

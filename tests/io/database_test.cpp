@@ -510,6 +510,42 @@ TEST_F(SmallDatabase, ABurstIsAnsweredInInputOrderExactlyAsEachMeshAlone) {
   EXPECT_TRUE(db->queryMany({}, options).empty());
 }
 
+// Opened with one descriptor kind, the database builds that index alone and answers by it exactly as a
+// database opened with all three does; a query by another kind is a clear error.
+TEST_F(SmallDatabase, OpenedWithOneDescriptorKindItAnswersByThatOneExactly) {
+  auto all = Database::open(sPath);
+  ASSERT_TRUE(all.ok()) << all.error().message;
+  Database::OpenOptions one;
+  one.descriptors = {core::DescriptorKind::kCentroidVoxel};
+  auto db = Database::open(sPath, one);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  EXPECT_TRUE(db->hasIndex(core::DescriptorKind::kCentroidVoxel));
+  EXPECT_FALSE(db->hasIndex(core::DescriptorKind::kMoment));
+  EXPECT_FALSE(db->hasIndex(core::DescriptorKind::kVoxel));
+  std::mt19937_64 rng(5);
+  QueryOptions options;
+  options.search.k = 3;
+  options.fidelity = false;
+  for (const core::TriangleMesh& mesh : ownSurfacesUnderSimilarities(*db, rng)) {
+    Result<QueryResult> a = all->query(mesh, options), b = db->query(mesh, options);
+    ASSERT_TRUE(a.ok() && b.ok());
+    ASSERT_EQ(b->matches.size(), a->matches.size());
+    for (std::size_t m = 0; m < a->matches.size(); ++m) {
+      EXPECT_EQ(b->matches[m].match.entry, a->matches[m].match.entry);
+      EXPECT_EQ(b->matches[m].match.distance, a->matches[m].match.distance);
+    }
+    EXPECT_EQ(b->physics->frequenciesHz(), a->physics->frequenciesHz());
+  }
+  options.descriptor = core::DescriptorKind::kMoment;
+  Result<QueryResult> refused = db->query(core::makeBox({1.0, 0.5, 0.25}), options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_NE(refused.error().message.find("opened without its moment index"), std::string::npos)
+      << refused.error().message;
+  one.descriptors.clear();
+  EXPECT_EQ(Database::open(sPath, one).error().code, ErrorCode::kInvalidArgument);
+}
+
 TEST(BuildParametersJson, ElementOrderRoundTripsAndOlderFilesAreLinear) {
   BuildParameters quadratic;
   quadratic.families = {volume::Family::kBox};

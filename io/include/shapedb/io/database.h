@@ -118,7 +118,7 @@ struct QueryResult {
   QueryTimes times;
 };
 
-/// An open database: every entry's descriptors in three in-RAM indexes (one per kind), its physical data
+/// An open database: every entry's descriptors in in-RAM indexes (one per kind opened), its physical data
 /// read on demand through a bounded cache. Thread-safe: concurrent searches and physics reads, and, opened
 /// with OpenOptions::learn, entries learned beside them (learn).
 class Database {
@@ -130,9 +130,14 @@ class Database {
     /// Open for learning too (learn(), io/enrich.h): a second, writable connection to the file beside the
     /// reading one. Errors then include a writable Store::open's (a read-only file or folder).
     bool learn = false;
+    /// The descriptor kinds whose indexes are built at open, each from its own descriptors in the file: a
+    /// query by another kind is then an error. All three by default; `query`, `haptic`, `sound` and `drop`
+    /// open with the one they search by, and read a third of what they did.
+    std::vector<core::DescriptorKind> descriptors{core::DescriptorKind::kMoment, core::DescriptorKind::kVoxel,
+                                                  core::DescriptorKind::kCentroidVoxel};
   };
-  /// Errors: Store::open's, kInvalidArgument (expectDescriptor differs: the message says how), kParse
-  /// (a corrupted descriptor).
+  /// Errors: Store::open's, kInvalidArgument (expectDescriptor differs: the message says how; no
+  /// descriptor kind to index), kParse (a corrupted descriptor).
   static Result<Database> open(const std::filesystem::path& path, const OpenOptions& options);
   static Result<Database> open(const std::filesystem::path& path) { return open(path, OpenOptions{}); }
 
@@ -154,7 +159,10 @@ class Database {
   /// valid as long as the Database.
   const EntryRecord* entry(core::EntryId id) const;
   const EntryRecord* entry(std::string_view name) const;
+  /// Whether the index of `kind` was built at open (OpenOptions::descriptors).
+  bool hasIndex(core::DescriptorKind kind) const;
   /// The index of one descriptor kind: the file's entries and those learned since.
+  /// Precondition: hasIndex(kind).
   const core::LiveIndex& index(core::DescriptorKind kind) const;
 
   /// Adds an entry computed elsewhere (io/enrich.h computes them) as a `learned` entry: written to the file
