@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <charconv>
 #include <cstring>
 #include <fstream>
@@ -15,15 +14,12 @@
 
 #include <shapedb/io/mesh_io.h>
 
+#include "mesh_format.h"
+
 namespace shapedb::io {
 namespace {
 
 constexpr std::uint64_t kCountedAbove = 16u << 20;  // text files smaller than this are not counted
-
-std::string lowercase(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
 
 // The file's first 64 KiB as lines: where a header's counts are, without reading a line of unbounded
 // length (a binary file may hold no newline at all).
@@ -125,9 +121,8 @@ std::optional<std::uint64_t> readUnsigned(const std::filesystem::path& path) {
 }  // namespace
 
 Result<MeshFileSize> estimateMeshFile(const std::filesystem::path& path) {
-  std::string format = lowercase(path.extension().string());
-  if (!format.empty()) format.erase(0, 1);
-  if (format != "obj" && format != "ply" && format != "off" && format != "stl")
+  const std::string format = detail::lowercaseExtension(path);
+  if (!detail::isMeshFormat(format))
     return Error{ErrorCode::kUnknownFormat,
                  path.string() + ": unknown mesh format '" + path.extension().string() + "'"};
   std::error_code ec;

@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -14,6 +13,7 @@
 #include <shapedb/core/weld.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "mesh_format.h"
 #include "openmesh_adapters.h"
 #include "text_mesh_readers.h"
 
@@ -30,13 +30,6 @@ std::mutex& openMeshMutex() {
     omerr().disable();
   });
   return mutex;
-}
-
-std::string lowercaseExtension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  if (!ext.empty()) ext.erase(0, 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
 }
 
 Error fileError(const std::filesystem::path& path, ErrorCode code, const std::string& message) {
@@ -154,11 +147,7 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
     return Error{ErrorCode::kIo, directory.string() + ": not a directory"};
   std::vector<fs::path> files;
   for (const fs::directory_entry& entry : fs::recursive_directory_iterator(directory, ec)) {
-    std::string extension = entry.path().extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (entry.is_regular_file() &&
-        (extension == ".obj" || extension == ".ply" || extension == ".off" || extension == ".stl"))
+    if (entry.is_regular_file() && detail::isMeshFormat(detail::lowercaseExtension(entry.path())))
       files.push_back(entry.path());
   }
   if (ec) return Error{ErrorCode::kIo, directory.string() + ": " + ec.message()};
@@ -170,8 +159,8 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
 
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options) {
   // Format by extension, then the file itself.
-  const std::string format = lowercaseExtension(path);
-  if (format != "obj" && format != "ply" && format != "off" && format != "stl")
+  const std::string format = detail::lowercaseExtension(path);
+  if (!detail::isMeshFormat(format))
     return fileError(
         path, ErrorCode::kUnknownFormat,
         "unknown mesh format '" + path.extension().string() + "' (expected .obj, .ply, .off or .stl)");
@@ -280,7 +269,7 @@ std::vector<std::string> LoadedMesh::notes() const {
 
 Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& path,
                 const SaveOptions& options) {
-  const std::string format = lowercaseExtension(path);
+  const std::string format = detail::lowercaseExtension(path);
   if (format != "obj" && format != "ply")
     return fileError(path, ErrorCode::kUnknownFormat,
                      "cannot write format '" + path.extension().string() + "' (expected .obj or .ply)");

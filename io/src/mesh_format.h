@@ -1,0 +1,26 @@
+#pragma once
+
+// A mesh file's format, from its name: one rule for the readers, the size estimate and folder listings.
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <string>
+
+namespace shapedb::io::detail {
+
+/// The extension without its dot, in lower case: "obj" for "Part.OBJ"; "" for none.
+inline std::string lowercaseExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+/// Whether `format` (as lowercaseExtension gives it) is one shapedb reads: obj, ply, off or stl.
+inline bool isMeshFormat(const std::string& format) {
+  return format == "obj" || format == "ply" || format == "off" || format == "stl";
+}
+
+}  // namespace shapedb::io::detail
