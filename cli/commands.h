@@ -62,6 +62,10 @@ void printError(const std::string& message);
 /// The flag that would get past a refusal of a mesh, as "; --flag ..." to append to its message, or "".
 std::string flagHint(const Error& error);
 
+/// Whether `error` refuses a surface for bounding no well-defined solid (open, non-manifold, inconsistently
+/// oriented): what --approximate gets past.
+bool boundsNoSolid(const Error& error);
+
 /// Adds --units, --scale, --weld-tolerance, --repair and --repair-resolution to `app`.
 void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags);
 

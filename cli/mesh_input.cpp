@@ -15,6 +15,11 @@ std::string flagHint(const Error& error) {
   return "";
 }
 
+bool boundsNoSolid(const Error& error) {
+  return error.code == ErrorCode::kNotClosed || error.code == ErrorCode::kNonManifold ||
+         error.code == ErrorCode::kInconsistentOrientation;
+}
+
 void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
   CLI::Option* units =
       app.add_option_function<std::string>(
@@ -123,8 +128,7 @@ std::optional<MeshInput> loadMeshInput(const std::string& path, const MeshInputO
   if (!mp) {
     std::string hint;
     if (mp.error().code == ErrorCode::kInsideOut) hint = "; --flip-inside-out flips it";
-    if (mp.error().code == ErrorCode::kNotClosed || mp.error().code == ErrorCode::kNonManifold ||
-        mp.error().code == ErrorCode::kInconsistentOrientation)
+    if (boundsNoSolid(mp.error()))
       hint = "; --approximate estimates from vertex point masses" + flagHint(mp.error());
     printError(path + ": " + mp.error().message + hint);
     return std::nullopt;

@@ -307,9 +307,7 @@ nlohmann::json queryJson(const std::string& file, const io::LoadedMesh& loaded,
 
 /// What query adds to a refusal of a surface that bounds no solid: the flag that answers it anyway.
 std::string approximateHint(const Error& error) {
-  if (error.code == ErrorCode::kNotClosed || error.code == ErrorCode::kNonManifold ||
-      error.code == ErrorCode::kInconsistentOrientation)
-    return "; --approximate answers it from vertex point masses (marked approximate)";
+  if (boundsNoSolid(error)) return "; --approximate answers it from vertex point masses (marked approximate)";
   return "";
 }
 
