@@ -11,12 +11,15 @@
 #include <shapedb/core/spatial.h>
 #include <shapedb/volume/morph.h>
 
+#include "mesh_motion.h"
+#include "sparse_cholesky.h"
+
 namespace shapedb::volume {
 namespace {
 
 using core::TetMesh;
 using core::Vec3;
-using SparseMatrix = Eigen::SparseMatrix<double>;
+using detail::SparseMatrix;
 
 /// The boundary of a tet mesh as morphing sees it: which nodes lie on it, their neighbours along boundary
 /// edges, and the faces (for normals).
@@ -64,33 +67,6 @@ Boundary findBoundary(const TetMesh& mesh) {
   return b;
 }
 
-/// Per node of a tet mesh, the nodes that share a tet with it, itself included (CSR).
-struct NodeNeighbours {
-  std::vector<std::uint32_t> start;
-  std::vector<std::uint32_t> nodes;
-};
-
-NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
-  std::vector<std::uint64_t> pairs;
-  pairs.reserve(16 * mesh.tetCount());
-  for (const auto& tet : mesh.tets)
-    for (std::uint32_t a : tet)
-      for (std::uint32_t b : tet)
-        pairs.push_back((static_cast<std::uint64_t>(a) << 32) | b);
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  NodeNeighbours out;
-  out.start.assign(mesh.nodeCount() + 1, 0);
-  out.nodes.reserve(pairs.size());
-  for (std::uint64_t p : pairs) {
-    ++out.start[(p >> 32) + 1];
-    out.nodes.push_back(static_cast<std::uint32_t>(p & 0xffffffffu));
-  }
-  for (std::size_t i = 0; i < mesh.nodeCount(); ++i)
-    out.start[i + 1] += out.start[i];
-  return out;
-}
-
 /// ∫ (x − c)(x − c)ᵀ dV at unit density, from the inertia about the centre of mass.
 core::Mat3 covariance(const core::MassProperties& m) {
   return core::covarianceFromInertia(m.inertia / m.density);
@@ -101,72 +77,6 @@ double worstQuality(const TetMesh& mesh) {
   for (std::size_t t = 0; t < mesh.tetCount(); ++t)
     worst = std::min(worst, tetQuality(mesh, t));
   return worst;
-}
-
-/// Stiffness of the linear elastic body that carries the boundary's displacement inwards (ν = 0.3,
-/// constant-strain tets), each tet's modulus 1/V_t so that small tets, which a given displacement would
-/// distort most, move most rigidly (the "Jacobian-based stiffening" of mesh-moving methods).
-SparseMatrix meshMotionStiffness(const TetMesh& mesh) {
-  const double nu = 0.3, lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = 0.5 / (1.0 + nu);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(144 * mesh.tetCount());
-  for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
-    const auto [grad, volume] = core::tetGradients(mesh, t);
-    // Element stiffness ∫ λ div u div v + μ (∇u + ∇uᵀ) : ∇v over the tet, times 1/V: the V cancels.
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        const Vec3 ga = grad.col(a), gb = grad.col(b);
-        const core::Mat3 block = lambda * ga * gb.transpose() + mu * gb * ga.transpose() +
-                                 mu * ga.dot(gb) * core::Mat3::Identity();
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            triplets.emplace_back(3 * static_cast<int>(mesh.tets[t][static_cast<std::size_t>(a)]) + i,
-                                  3 * static_cast<int>(mesh.tets[t][static_cast<std::size_t>(b)]) + j,
-                                  block(i, j));
-      }
-  }
-  const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
-  SparseMatrix k(n, n);
-  k.setFromTriplets(triplets.begin(), triplets.end());
-  return k;
-}
-
-/// Moves the inner nodes of `mesh` for the boundary displacement `boundaryMove` (3 per boundary node):
-/// K_ii u_i = −K_ib u_b. Errors when the system cannot be factorized (a mesh with no inner node needs none).
-Status extendInwards(TetMesh& mesh, const Boundary& boundary, const Eigen::VectorXd& boundaryMove) {
-  const std::size_t n = mesh.nodeCount();
-  std::vector<int> inner(n, -1);
-  int innerCount = 0;
-  for (std::size_t v = 0; v < n; ++v)
-    if (boundary.slot[v] < 0) inner[v] = innerCount++;
-  // Assembled on the mesh as it stands before this increment.
-  const SparseMatrix k = innerCount ? meshMotionStiffness(mesh) : SparseMatrix();
-  for (std::size_t i = 0; i < boundary.nodes.size(); ++i)
-    mesh.nodes[boundary.nodes[i]] += boundaryMove.segment<3>(3 * static_cast<Eigen::Index>(i));
-  if (innerCount == 0) return Ok{};
-  std::vector<Eigen::Triplet<double>> kii;
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * innerCount);
-  for (int col = 0; col < k.outerSize(); ++col) {
-    const auto v = static_cast<std::size_t>(col / 3);
-    for (SparseMatrix::InnerIterator it(k, col); it; ++it) {
-      const auto u = static_cast<std::size_t>(it.row() / 3);
-      if (inner[u] < 0) continue;
-      const int row = 3 * inner[u] + static_cast<int>(it.row() % 3);
-      if (inner[v] >= 0)
-        kii.emplace_back(row, 3 * inner[v] + col % 3, it.value());
-      else
-        rhs[row] -= it.value() * boundaryMove[3 * boundary.slot[v] + col % 3];
-    }
-  }
-  SparseMatrix a(3 * innerCount, 3 * innerCount);
-  a.setFromTriplets(kii.begin(), kii.end());
-  Eigen::SimplicialLDLT<SparseMatrix> solver(a);
-  if (solver.info() != Eigen::Success)
-    return Error{ErrorCode::kInvalidArgument, "the mesh-motion system could not be factorized"};
-  const Eigen::VectorXd u = solver.solve(rhs);
-  for (std::size_t v = 0; v < n; ++v)
-    if (inner[v] >= 0) mesh.nodes[v] += u.segment<3>(3 * inner[v]);
-  return Ok{};
 }
 
 /// Per boundary node, a third of the area of its boundary faces at positions `nodes`.
@@ -187,10 +97,11 @@ std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh)
 /// stiffness of the start configuration, w growing round by round. A round whose displacement would push a
 /// tet under `minQuality` is taken in part (halved up to three times) or not at all.
 void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::TriangleMesh& target,
-                         const core::ClosestPointTree& targetTree, int rounds, double minQuality) {
+                         const core::ClosestPointTree& targetTree, int rounds, double minQuality,
+                         detail::MotionStiffness& stiffness) {
   if (rounds <= 0) return;
   const TetMesh start = mesh;
-  const SparseMatrix k = meshMotionStiffness(start);
+  const SparseMatrix k = stiffness.assemble(start);
   const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
   const std::vector<double> nodeArea = boundaryAreas(boundary, start);
   // The target's side: up to 2,000 of its vertices, each with its share of the target's area.
@@ -201,14 +112,19 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
     stiffnessScale += k.coeff(i, i);
   for (double a : nodeArea)
     fitScale += 3.0 * a;
-  Eigen::SimplicialLDLT<SparseMatrix> solver;
+  // CHOLMOD's supernodal factor, in a node-block order worked out once: K's sparsity holds the fit's.
+  detail::SparseCholesky solver;
+  const std::vector<int> order = detail::nodeBlockOrder(k);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
   for (int round = 0; round < rounds; ++round) {
     // From stiff (the fit moves the body nearly as a whole) to close: w from 0.1 to 100 times the
     // stiffness, in equal ratios.
     const double ratio = rounds == 1 ? 1.0 : std::pow(1000.0, static_cast<double>(round) / (rounds - 1));
     const double w = 0.1 * ratio * stiffnessScale / fitScale;
-    std::vector<Eigen::Triplet<double>> fit;
+    // A = K + the fit terms, which couple only nodes of one boundary face: within K's sparsity.
+    SparseMatrix a = k;
+    double* values = a.valuePtr();
+    bool inPattern = true;
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
     const auto addPoint = [&](std::span<const std::uint32_t> nodes, std::span<const double> weights,
                               const Vec3& goal, double weight) {
@@ -217,10 +133,13 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
       for (std::size_t i = 0; i < nodes.size(); ++i)
         at += weights[i] * start.nodes[nodes[i]];
       for (std::size_t i = 0; i < nodes.size(); ++i) {
-        for (std::size_t j = 0; j < nodes.size(); ++j)
-          for (int c = 0; c < 3; ++c)
-            fit.emplace_back(3 * static_cast<int>(nodes[i]) + c, 3 * static_cast<int>(nodes[j]) + c,
-                             weight * weights[i] * weights[j]);
+        for (std::size_t j = 0; j < nodes.size(); ++j) {
+          const std::array<Eigen::Index, 3> slots = stiffness.diagonalIndices(nodes[i], nodes[j]);
+          inPattern = inPattern && slots[0] >= 0;
+          if (slots[0] >= 0)
+            for (Eigen::Index index : slots)
+              values[index] += weight * weights[i] * weights[j];
+        }
         rhs.segment<3>(3 * static_cast<Eigen::Index>(nodes[i])) += weight * weights[i] * (goal - at);
       }
     };
@@ -246,14 +165,11 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
       addPoint(t, hit.closest.barycentric, target.vertices[v],
                w * vertexArea[v] * static_cast<double>(stride));
     }
-    SparseMatrix a(n, n);
-    a.setFromTriplets(fit.begin(), fit.end());
-    a += k;
-    if (round == 0) solver.analyzePattern(a);
-    solver.factorize(a);
-    if (solver.info() != Eigen::Success) break;
+    if (!inPattern) break;  // cannot be: two nodes of a boundary face share its tet
+    if (!solver.factorize(a, order)) break;
     // The fit terms hold the start configuration's rigid motions, so the system is definite.
-    const Eigen::VectorXd next = solver.solve(rhs);
+    Eigen::VectorXd next(n);
+    if (!solver.solve(rhs.data(), next.data())) break;
     // Take the round's step, or as much of it as keeps every tet above the bound.
     bool taken = false;
     for (double t = 1.0; t >= 0.125 && !taken; t *= 0.5) {
@@ -319,7 +235,12 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& 
   // Elastic registration, then every boundary node onto its closest target point.
   const Boundary boundary = findBoundary(out.mesh);
   const core::ClosestPointTree tree(target);
-  registerElastically(out.mesh, boundary, target, tree, options.registrationRounds, minQuality);
+  std::vector<char> isBoundary(out.mesh.nodeCount(), 0);
+  for (std::uint32_t node : boundary.nodes)
+    isBoundary[node] = 1;
+  detail::InteriorMotion motion(out.mesh, isBoundary);
+  registerElastically(out.mesh, boundary, target, tree, options.registrationRounds, minQuality,
+                      motion.stiffness());
   std::vector<Vec3> p(boundary.nodes.size());
   for (std::size_t i = 0; i < p.size(); ++i)
     p[i] = tree.closest(out.mesh.nodes[boundary.nodes[i]]).closest.point;
@@ -337,7 +258,7 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& 
   std::vector<double> taken(boundary.nodes.size(), 1.0);
   const std::array<int, 2> incrementSteps{1, options.maxIncrements};
   bool done = false;
-  const NodeNeighbours neighbours = nodeNeighbours(mesh);
+  const detail::NodeNeighbours& neighbours = motion.stiffness().neighbours();
   constexpr int kRounds = 8;
   for (int round = 0; round < kRounds && !done; ++round) {
     const bool last = round == kRounds - 1;
@@ -349,7 +270,7 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& 
     for (const int increments : incrementSteps) {
       TetMesh moved = start;
       for (int k = 0; k < increments; ++k)
-        if (Status st = extendInwards(moved, boundary, step / increments); !st) return st.error();
+        if (Status st = motion.extend(moved, step / increments); !st) return st.error();
       bad.clear();
       for (std::size_t t = 0; t < moved.tetCount(); ++t)
         if (tetQuality(moved, t) < minQuality) bad.push_back(t);

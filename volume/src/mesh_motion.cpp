@@ -1,0 +1,201 @@
+#include "mesh_motion.h"
+
+#include <algorithm>
+
+namespace shapedb::volume::detail {
+namespace {
+
+using core::TetMesh;
+using core::Vec3;
+
+/// Calls sink(a, b, block) with each 3 × 3 block of tet t's element stiffness in meshMotionStiffness:
+/// ∫ λ div u div v + μ (∇u + ∇uᵀ) : ∇v over the tet, times 1/V (the V cancels), for its nodes a and b.
+template <class Sink>
+void forEachElementBlock(const TetMesh& mesh, std::size_t t, Sink&& sink) {
+  constexpr double nu = 0.3, lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = 0.5 / (1.0 + nu);
+  const auto [grad, volume] = core::tetGradients(mesh, t);
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b) {
+      const Vec3 ga = grad.col(a), gb = grad.col(b);
+      const core::Mat3 block =
+          lambda * ga * gb.transpose() + mu * gb * ga.transpose() + mu * ga.dot(gb) * core::Mat3::Identity();
+      sink(a, b, block);
+    }
+}
+
+}  // namespace
+
+NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
+  std::vector<std::uint64_t> pairs;
+  pairs.reserve(16 * mesh.tetCount());
+  for (const auto& tet : mesh.tets)
+    for (std::uint32_t a : tet)
+      for (std::uint32_t b : tet)
+        pairs.push_back((static_cast<std::uint64_t>(a) << 32) | b);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  NodeNeighbours out;
+  out.start.assign(mesh.nodeCount() + 1, 0);
+  out.nodes.reserve(pairs.size());
+  for (std::uint64_t p : pairs) {
+    ++out.start[(p >> 32) + 1];
+    out.nodes.push_back(static_cast<std::uint32_t>(p & 0xffffffffu));
+  }
+  for (std::size_t i = 0; i < mesh.nodeCount(); ++i)
+    out.start[i + 1] += out.start[i];
+  return out;
+}
+
+SparseMatrix meshMotionStiffness(const TetMesh& mesh) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(144 * mesh.tetCount());
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t)
+    forEachElementBlock(mesh, t, [&](int a, int b, const core::Mat3& block) {
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          triplets.emplace_back(3 * static_cast<int>(mesh.tets[t][static_cast<std::size_t>(a)]) + i,
+                                3 * static_cast<int>(mesh.tets[t][static_cast<std::size_t>(b)]) + j,
+                                block(i, j));
+    });
+  const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
+  SparseMatrix k(n, n);
+  k.setFromTriplets(triplets.begin(), triplets.end());
+  return k;
+}
+
+MotionStiffness::MotionStiffness(const TetMesh& mesh) : mNeighbours(nodeNeighbours(mesh)) {
+  // Column 3v + j holds rows 3u + i for every neighbour u of v (ascending) and i = 0, 1, 2: the three
+  // columns of a node have the same rows, and a node's three rows are consecutive.
+  const std::size_t nodes = mesh.nodeCount();
+  const auto n = static_cast<Eigen::Index>(3 * nodes);
+  mK.resize(n, n);
+  mK.resizeNonZeros(static_cast<Eigen::Index>(9 * mNeighbours.nodes.size()));
+  int* outer = mK.outerIndexPtr();
+  int* inner = mK.innerIndexPtr();
+  for (std::size_t v = 0; v < nodes; ++v) {
+    const std::uint32_t first = mNeighbours.start[v], degree = mNeighbours.start[v + 1] - first;
+    for (std::uint32_t j = 0; j < 3; ++j) {
+      const auto column = static_cast<int>(9 * first + 3 * j * degree);
+      outer[3 * v + j] = column;
+      for (std::uint32_t k = 0; k < degree; ++k)
+        for (std::uint32_t i = 0; i < 3; ++i)
+          inner[column + static_cast<int>(3 * k + i)] =
+              static_cast<int>(3 * mNeighbours.nodes[first + k] + i);
+    }
+  }
+  outer[n] = static_cast<int>(9 * mNeighbours.nodes.size());
+  std::fill_n(mK.valuePtr(), mK.nonZeros(), 0.0);
+  mSlots.resize(mesh.tetCount());
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t)
+    for (std::size_t a = 0; a < 4; ++a)
+      for (std::size_t b = 0; b < 4; ++b) {
+        const std::uint32_t u = mesh.tets[t][a], v = mesh.tets[t][b];
+        const auto begin = mNeighbours.nodes.begin() + mNeighbours.start[v];
+        mSlots[t][4 * a + b] = static_cast<std::uint32_t>(
+            std::lower_bound(begin, mNeighbours.nodes.begin() + mNeighbours.start[v + 1], u) - begin);
+      }
+}
+
+const SparseMatrix& MotionStiffness::assemble(const TetMesh& mesh) {
+  double* values = mK.valuePtr();
+  std::fill_n(values, mK.nonZeros(), 0.0);
+  const int* outer = mK.outerIndexPtr();
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t)
+    forEachElementBlock(mesh, t, [&](int a, int b, const core::Mat3& block) {
+      const std::uint32_t v = mesh.tets[t][static_cast<std::size_t>(b)];
+      const std::uint32_t k = mSlots[t][static_cast<std::size_t>(4 * a + b)];
+      for (int j = 0; j < 3; ++j) {
+        double* column = values + outer[3 * v + static_cast<std::uint32_t>(j)] + 3 * k;
+        for (int i = 0; i < 3; ++i)
+          column[i] += block(i, j);
+      }
+    });
+  return mK;
+}
+
+Eigen::Index MotionStiffness::valueIndex(std::uint32_t u, std::uint32_t v, int i, int j) const {
+  const auto begin = mNeighbours.nodes.begin() + mNeighbours.start[v],
+             end = mNeighbours.nodes.begin() + mNeighbours.start[v + 1];
+  const auto at = std::lower_bound(begin, end, u);
+  if (at == end || *at != u) return -1;
+  return mK.outerIndexPtr()[3 * v + static_cast<std::uint32_t>(j)] + 3 * (at - begin) + i;
+}
+
+std::array<Eigen::Index, 3> MotionStiffness::diagonalIndices(std::uint32_t u, std::uint32_t v) const {
+  const Eigen::Index first = valueIndex(u, v, 0, 0);
+  if (first < 0) return {-1, -1, -1};
+  const int* outer = mK.outerIndexPtr() + 3 * v;
+  return {first, first - outer[0] + outer[1] + 1, first - outer[0] + outer[2] + 2};
+}
+
+InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoundary) : mStiffness(mesh) {
+  const std::size_t n = mesh.nodeCount();
+  mInner.assign(n, -1);
+  mBoundarySlot.assign(n, -1);
+  int boundaryCount = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (isBoundary[v])
+      mBoundarySlot[v] = boundaryCount++;
+    else
+      mInner[v] = mInnerCount++;
+  }
+  if (mInnerCount == 0) return;
+  // K_ii: K's rows and columns of the inner nodes. Inner nodes are numbered in the mesh's order, so each
+  // column's rows stay ascending.
+  const SparseMatrix& k = mStiffness.matrix();
+  mToInner.assign(static_cast<std::size_t>(k.nonZeros()), -1);
+  mKii.resize(3 * mInnerCount, 3 * mInnerCount);
+  std::vector<int> outer(static_cast<std::size_t>(3 * mInnerCount) + 1, 0), inner;
+  for (Eigen::Index col = 0; col < k.outerSize(); ++col) {
+    const int v = mInner[static_cast<std::size_t>(col / 3)];
+    if (v < 0) continue;
+    const auto innerCol = static_cast<std::size_t>(3 * v + col % 3);
+    for (Eigen::Index at = k.outerIndexPtr()[col]; at < k.outerIndexPtr()[col + 1]; ++at) {
+      const int row = k.innerIndexPtr()[at], u = mInner[static_cast<std::size_t>(row / 3)];
+      if (u < 0) continue;
+      mToInner[static_cast<std::size_t>(at)] = static_cast<Eigen::Index>(inner.size());
+      inner.push_back(3 * u + row % 3);
+    }
+    outer[innerCol + 1] = static_cast<int>(inner.size());
+  }
+  mKii.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
+  std::copy(outer.begin(), outer.end(), mKii.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), mKii.innerIndexPtr());
+  std::fill_n(mKii.valuePtr(), mKii.nonZeros(), 0.0);
+}
+
+Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
+  // Assembled on the mesh as it stands before this increment.
+  const SparseMatrix* k = mInnerCount ? &mStiffness.assemble(mesh) : nullptr;
+  for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
+    if (const int slot = mBoundarySlot[v]; slot >= 0) mesh.nodes[v] += boundaryMove.segment<3>(3 * slot);
+  if (!k) return Ok{};
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
+  double* kii = mKii.valuePtr();
+  const double* values = k->valuePtr();
+  for (Eigen::Index col = 0; col < k->outerSize(); ++col) {
+    const int slot = mBoundarySlot[static_cast<std::size_t>(col / 3)];
+    for (Eigen::Index at = k->outerIndexPtr()[col]; at < k->outerIndexPtr()[col + 1]; ++at) {
+      const Eigen::Index to = mToInner[static_cast<std::size_t>(at)];
+      if (to >= 0) {
+        kii[to] = values[at];
+      } else if (slot >= 0) {  // column of a boundary node: −K_ib u_b, for the inner rows
+        const int row = k->innerIndexPtr()[at], u = mInner[static_cast<std::size_t>(row / 3)];
+        if (u >= 0) rhs[3 * u + row % 3] -= values[at] * boundaryMove[3 * slot + col % 3];
+      }
+    }
+  }
+  if (!mAnalyzed) {
+    mSolver.analyzePattern(mKii);
+    mAnalyzed = true;
+  }
+  mSolver.factorize(mKii);
+  if (mSolver.info() != Eigen::Success)
+    return Error{ErrorCode::kInvalidArgument, "the mesh-motion system could not be factorized"};
+  const Eigen::VectorXd u = mSolver.solve(rhs);
+  for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
+    if (const int i = mInner[v]; i >= 0) mesh.nodes[v] += u.segment<3>(3 * i);
+  return Ok{};
+}
+
+}  // namespace shapedb::volume::detail

@@ -1,0 +1,84 @@
+#pragma once
+// The mesh-motion stiffness that carries a morph's boundary displacement into a tet mesh, assembled as
+// often as the mesh moves: a morph assembles it once per interior increment and fits the registration with
+// it. The tets fix its sparsity (a 3 × 3 block for every two nodes that share a tet), so it is laid out once
+// and assembled again by writing values only, and the interior's system keeps one symbolic factorization.
+// Private to the volume module.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <shapedb/core/physics.h>
+#include <shapedb/core/result.h>
+
+namespace shapedb::volume::detail {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// Per node of a tet mesh, the nodes that share a tet with it, itself included, ascending (CSR).
+struct NodeNeighbours {
+  std::vector<std::uint32_t> start;
+  std::vector<std::uint32_t> nodes;
+};
+NodeNeighbours nodeNeighbours(const core::TetMesh& mesh);
+
+/// Stiffness of the linear elastic body that carries a boundary displacement inwards (ν = 0.3,
+/// constant-strain tets), each tet's modulus 1/V_t so that small tets, which a given displacement would
+/// distort most, move most rigidly (the "Jacobian-based stiffening" of mesh-moving methods). Assembled
+/// from triplets: the reference that MotionStiffness is tested against.
+SparseMatrix meshMotionStiffness(const core::TetMesh& mesh);
+
+/// meshMotionStiffness with its sparsity laid out once for a mesh's tets: assemble() on the nodes' current
+/// positions writes values only (the same values, summed in another order).
+class MotionStiffness {
+ public:
+  explicit MotionStiffness(const core::TetMesh& mesh);
+
+  /// K at `mesh`'s node positions; `mesh` has the tets this was made for.
+  const SparseMatrix& assemble(const core::TetMesh& mesh);
+  const SparseMatrix& matrix() const { return mK; }
+  const NodeNeighbours& neighbours() const { return mNeighbours; }
+  /// Index in matrix().valuePtr() of row 3u + i, column 3v + j; −1 when nodes u and v share no tet.
+  Eigen::Index valueIndex(std::uint32_t u, std::uint32_t v, int i, int j) const;
+  /// valueIndex(u, v, c, c) for c = 0, 1, 2 (one search); all −1 when u and v share no tet.
+  std::array<Eigen::Index, 3> diagonalIndices(std::uint32_t u, std::uint32_t v) const;
+
+ private:
+  NodeNeighbours mNeighbours;
+  SparseMatrix mK;
+  /// Per tet, per (a, b): where node a sits among node b's neighbours.
+  std::vector<std::array<std::uint32_t, 16>> mSlots;
+};
+
+/// Carries a boundary displacement into the interior of a mesh whose tets and boundary stay the same from
+/// call to call: K_ii u_i = −K_ib u_b with K assembled on the mesh as it stands. The inner system's
+/// sparsity and its fill-reducing order are worked out on the first call and kept.
+class InteriorMotion {
+ public:
+  /// `isBoundary[v]`: node v's displacement is given.
+  InteriorMotion(const core::TetMesh& mesh, std::span<const char> isBoundary);
+
+  /// The mesh-motion stiffness this assembles (for others to assemble on the same tets).
+  MotionStiffness& stiffness() { return mStiffness; }
+
+  /// Moves `mesh`'s boundary nodes by `boundaryMove` (3 per boundary node, ascending node order) and its
+  /// inner nodes as the elastic body would. Errors when the system cannot be factorized.
+  Status extend(core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove);
+
+ private:
+  MotionStiffness mStiffness;
+  std::vector<int> mInner;         ///< per node: its index among the inner nodes, or −1
+  std::vector<int> mBoundarySlot;  ///< per node: its index among the boundary nodes, or −1
+  int mInnerCount = 0;
+  SparseMatrix mKii;
+  std::vector<Eigen::Index> mToInner;  ///< per value of K: its index in mKii's values, or −1 (coupling)
+  Eigen::SimplicialLDLT<SparseMatrix> mSolver;
+  bool mAnalyzed = false;
+};
+
+}  // namespace shapedb::volume::detail
