@@ -60,14 +60,20 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
                                   std::size_t candidates, const volume::ModalOptions& modal,
                                   const volume::CorrectionOptions& options) {
   Correction out;
-  std::optional<volume::MorphedEntry> chosen;
-  double morphSeconds = 0.0;
-  for (std::size_t i = 0; i < candidates; ++i) {
+  // The candidates' morphs at once (each its own task: on a free core, the correction waits for the
+  // slowest morph rather than for all of them), then chosen in rank order, the better rank among equals.
+  std::vector<std::optional<Result<volume::MorphedEntry>>> morphs(candidates);
+  tbb::parallel_for(std::size_t{0}, candidates, [&](std::size_t i) {
     const core::Placement placement = core::placementOf(q.normalization, q.matches[i].match.orientation);
     core::TriangleMesh target = mesh;
     for (core::Vec3& p : target.vertices)
       p = placement.toEntry(p);
-    auto morphed = volume::morphEntry(entries[i]->data, target, options);
+    morphs[i] = volume::morphEntry(entries[i]->data, target, options);
+  });
+  std::optional<volume::MorphedEntry> chosen;
+  double morphSeconds = 0.0;
+  for (std::size_t i = 0; i < candidates; ++i) {
+    Result<volume::MorphedEntry>& morphed = *morphs[i];
     if (!morphed) {
       if (out.error.empty()) out.error = morphed.error().message;
       continue;
