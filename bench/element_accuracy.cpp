@@ -99,9 +99,13 @@ int main(int argc, char** argv) {
               volume::tetgenSwitches(options.tetgen, 1.0).c_str(),
               volume::tetgenSwitches(reference.tetgen, 1.0).c_str(), modes);
 
-  const std::size_t perFamilyInCatalog = defaults.entries / volume::generatedFamilies().size();
+  // Samples spread over each family's sweep as far as the default catalog takes it.
+  const volume::FamilyMix mix = volume::defaultFamilyMix();
+  const auto catalog = volume::buildCatalog(defaults.entries, mix.families, mix.weights);
   std::vector<Row> rows;
   for (volume::Family family : families) {
+    const auto perFamilyInCatalog = static_cast<std::size_t>(
+        std::ranges::count(catalog, family, [](const volume::ShapeSpec& spec) { return spec.family; }));
     for (int s = 0; s < perFamily; ++s) {
       const auto index = static_cast<std::uint32_t>(perFamilyInCatalog * static_cast<std::size_t>(s) /
                                                     static_cast<std::size_t>(perFamily));

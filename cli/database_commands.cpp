@@ -66,7 +66,7 @@ class ProgressPrinter {
 
 struct BuildCommandOptions {
   std::string path;
-  std::size_t entries = 1100;
+  std::size_t entries = io::BuildParameters{}.entries;
   std::string families = "all";
   int modes = 20;
   std::string elements = "quadratic";
@@ -86,12 +86,13 @@ int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
   options.resume = o.resume;
   io::BuildParameters& p = options.parameters;
   p.entries = o.entries;
-  auto families = volume::parseFamilies(o.families);
-  if (!families) {
-    printError(families.error().message);
+  auto mix = volume::parseFamilyMix(o.families);
+  if (!mix) {
+    printError("--families: " + mix.error().message);
     return kExitUsage;
   }
-  p.families = std::move(families).value();
+  p.families = std::move(mix->families);
+  p.weights = std::move(mix->weights);
   const auto elements = volume::parseElementOrder(o.elements);
   if (!elements) {
     printError("--elements must be linear or quadratic, not '" + o.elements + "'");
@@ -116,7 +117,10 @@ int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
       if (app.count(flag) && differs && conflict.empty()) conflict = flag;
     };
     check("--entries", have.entries != p.entries);
-    check("--families", have.families != p.families);
+    const auto evenIfNone = [](const io::BuildParameters& q) {
+      return q.weights.empty() ? std::vector<unsigned>(q.families.size(), 1) : q.weights;
+    };
+    check("--families", have.families != p.families || evenIfNone(have) != evenIfNone(p));
     check("--modes", have.entry.modal.modes != p.entry.modal.modes);
     check("--elements", have.entry.modal.order != p.entry.modal.order);
     check("--grid", have.entry.descriptor.gridSize != p.entry.descriptor.gridSize);
@@ -331,7 +335,7 @@ Command addBuildCommand(CLI::App& parent) {
       "all cores; commits every --batch entries, so an interrupted build loses little: continue it with\n"
       "--resume.");
   app->add_option("DB", o->path, "Database file to create (or to continue, with --resume)")->required();
-  app->add_option("--entries", o->entries, "Entries in the catalog, spread evenly over the families")
+  app->add_option("--entries", o->entries, "Entries in the catalog, shared out over the families by weight")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{10'000'000}));
   const auto join = [](auto families) {
@@ -341,9 +345,17 @@ Command addBuildCommand(CLI::App& parent) {
     return names;
   };
   const auto all = volume::generatedFamilies(), convex = volume::convexFamilies();
+
   app->add_option(
          "--families", o->families,
-         "Comma-separated families, or all. Convex (the catalog of older databases):\n" + join(convex) +
+         "Comma-separated families, each with an optional weight: its share of the entries relative to\n"
+         "the others' (\"box,fragment:3\": three fragments to a box; 1 unless given). Or all: the sixteen,\n"
+         "fragments weighted " +
+             std::to_string(volume::defaultFamilyWeight(volume::Family::kFragment)) + " and shards " +
+             std::to_string(volume::defaultFamilyWeight(volume::Family::kShard)) +
+             " (what fracture breaks off, asked for in bursts, spans more\nshapes than the others). "
+             "Convex (the catalog of older databases):\n" +
+             join(convex) +
              ".\nWith the handles, hooks, webs, holes, cavities, limbs and lumps of real objects:\n" +
              join(all.subspan(convex.size())))
       ->capture_default_str();

@@ -35,6 +35,9 @@ std::string utcNow() {
 Status validateParameters(const BuildParameters& p) {
   if (p.entries == 0) return Error{ErrorCode::kInvalidArgument, "a database needs at least one entry"};
   if (p.families.empty()) return Error{ErrorCode::kInvalidArgument, "no family to build"};
+  if (!volume::validFamilyWeights(p.families.size(), p.weights))
+    return Error{ErrorCode::kInvalidArgument, "the family weights must be one per family, each from 1 to " +
+                                                  std::to_string(volume::kMaxFamilyWeight)};
   if (Status st = volume::validateDescriptorOptions(p.entry.descriptor); !st) return st;
   if (p.entry.modal.modes < 1 || p.entry.modal.modes > 200)
     return Error{ErrorCode::kInvalidArgument, "modes must be in [1, 200]"};
@@ -110,7 +113,7 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
     done.insert(r.name);
   for (const FailureRecord& f : *failed)
     done.insert(f.name);
-  const std::vector<volume::ShapeSpec> catalog = volume::buildCatalog(p.entries, p.families);
+  const std::vector<volume::ShapeSpec> catalog = volume::buildCatalog(p.entries, p.families, p.weights);
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < catalog.size(); ++i)
     if (!done.count(catalog[i].name())) todo.push_back(i);

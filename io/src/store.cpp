@@ -129,6 +129,7 @@ std::string toJson(const BuildParameters& p) {
   const json j = {
       {"entries", p.entries},
       {"families", families},
+      {"weights", p.weights},
       {"resolution", {{"segments", p.resolution.segments}, {"stacks", p.resolution.stacks}}},
       {"descriptor",
        {{"grid", e.descriptor.gridSize},
@@ -162,6 +163,11 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
         return Error{ErrorCode::kParse,
                      "unknown family '" + f.get<std::string>() + "' in the build parameters"};
       p.families.push_back(*family);
+    }
+    if (const auto w = j.find("weights"); w != j.end()) {
+      p.weights = w->get<std::vector<unsigned>>();
+      if (!volume::validFamilyWeights(p.families.size(), p.weights))
+        return Error{ErrorCode::kParse, "the build parameters' family weights do not fit their families"};
     }
     p.resolution.segments = j.at("resolution").at("segments").get<int>();
     p.resolution.stacks = j.at("resolution").at("stacks").get<int>();

@@ -76,7 +76,7 @@ std::size_t committedEntries(const std::filesystem::path& path) {
 TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
   test::ScratchDir dir("build-kill");
   const auto killed = dir / "killed.db", clean = dir / "clean.db";
-  const std::vector<std::string> args = {"--entries", "24", "--families", "box,cone,shard",
+  const std::vector<std::string> args = {"--entries", "24", "--families", "box,cone:2,shard",
                                          "--modes",   "4",  "--threads",  "1",
                                          "--batch",   "2",  "--quiet"};
 
@@ -111,6 +111,11 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
       test::runProcess(SHAPEDB_CLI, {"build", killed.string(), "--resume", "--modes", "8", "--quiet"});
   EXPECT_EQ(conflict.exitCode, 2);
   EXPECT_NE(conflict.err.find("was built with another modes"), std::string::npos) << conflict.err;
+  // The same families weighted otherwise are another catalog.
+  conflict = test::runProcess(
+      SHAPEDB_CLI, {"build", killed.string(), "--resume", "--families", "box,cone,shard", "--quiet"});
+  EXPECT_EQ(conflict.exitCode, 2);
+  EXPECT_NE(conflict.err.find("was built with another families"), std::string::npos) << conflict.err;
 }
 
 TEST(BuildCli, AFullDiskFailsClearlyKeepsWhatWasCommittedAndTheBuildResumes) {

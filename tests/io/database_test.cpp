@@ -568,6 +568,28 @@ TEST(BuildParametersJson, ElementOrderRoundTripsAndOlderFilesAreLinear) {
   EXPECT_NE(back.error().message.find("element order"), std::string::npos) << back.error().message;
 }
 
+TEST(BuildParametersJson, FamilyWeightsRoundTripAndOlderFilesAreEven) {
+  BuildParameters weighted;
+  weighted.families = {volume::Family::kBox, volume::Family::kFragment};
+  weighted.weights = {1, 4};
+  Result<BuildParameters> back = parseBuildParameters(toJson(weighted));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->weights, weighted.weights);
+
+  // A file written before weights existed: its catalog was even.
+  nlohmann::json older = nlohmann::json::parse(toJson(weighted));
+  older.erase("weights");
+  back = parseBuildParameters(older.dump());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_TRUE(back->weights.empty());
+  for (const nlohmann::json& bad : {nlohmann::json{1}, nlohmann::json{1, 0}, nlohmann::json{1, 101}}) {
+    older["weights"] = bad;
+    back = parseBuildParameters(older.dump());
+    ASSERT_FALSE(back.ok()) << bad.dump();
+    EXPECT_NE(back.error().message.find("weights"), std::string::npos) << back.error().message;
+  }
+}
+
 TEST_F(SmallDatabase, OtherDescriptorParametersAreAClearError) {
   core::DescriptorOptions other;
   other.gridSize = 12;

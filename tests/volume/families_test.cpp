@@ -1,4 +1,9 @@
+#include <algorithm>
+#include <map>
+#include <random>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -200,6 +205,91 @@ TEST(Families, FragmentsAreConvexCellsInsideTheirSolid) {
     EXPECT_LT(mass->volume, solidVolume) << spec.name();
   }
   EXPECT_GT(pieces.size(), 20u);  // the counts vary, not one value for every fragment
+}
+
+std::vector<std::string> names(const std::vector<ShapeSpec>& catalog) {
+  std::vector<std::string> out;
+  for (const ShapeSpec& spec : catalog)
+    out.push_back(spec.name());
+  return out;
+}
+
+// Largest remainders, judged by what they promise rather than recomputed: every family gets its share
+// rounded down or up, the entries add up, and a family rounded up never has a smaller fraction than one
+// rounded down (nor an equal one, coming after it).
+TEST(Families, AWeightedCatalogSharesTheEntriesByLargestRemainders) {
+  std::mt19937_64 rng(24);
+  std::vector<Family> all(generatedFamilies().begin(), generatedFamilies().end());
+  for (int trial = 0; trial < 300; ++trial) {
+    std::shuffle(all.begin(), all.end(), rng);
+    const std::size_t n = 1 + rng() % all.size();
+    const std::vector<Family> families(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n));
+    std::vector<unsigned> weights(n);
+    for (unsigned& w : weights)
+      w = 1 + static_cast<unsigned>(rng() % (trial % 3 == 0 ? 1 : kMaxFamilyWeight));
+    const std::size_t entries = rng() % 5000;
+    const auto catalog = buildCatalog(entries, families, weights);
+    ASSERT_EQ(catalog.size(), entries);
+    std::size_t total = 0;
+    for (unsigned w : weights)
+      total += w;
+    std::vector<std::size_t> counts(n);
+    for (std::size_t k = 0, f = 0; k < catalog.size(); ++k) {
+      while (catalog[k].family != families[f])
+        ++f;  // family by family, in the given order
+      ASSERT_EQ(catalog[k].index, counts[f]) << "each family's sweep from index 0";
+      ++counts[f];
+    }
+    std::vector<bool> up(n);
+    for (std::size_t f = 0; f < n; ++f) {
+      const std::size_t floor = entries * weights[f] / total;
+      ASSERT_TRUE(counts[f] == floor || counts[f] == floor + 1) << "family " << f << " of trial " << trial;
+      up[f] = counts[f] == floor + 1;
+    }
+    for (std::size_t x = 0; x < n; ++x)
+      for (std::size_t y = 0; y < n; ++y) {
+        if (!up[x] || up[y]) continue;
+        const std::size_t fx = entries * weights[x] % total, fy = entries * weights[y] % total;
+        EXPECT_TRUE(fx > fy || (fx == fy && x < y)) << "trial " << trial;
+      }
+    // No weights and equal weights are the same even catalog.
+    if (std::ranges::all_of(weights, [&](unsigned w) { return w == weights[0]; })) {
+      EXPECT_EQ(names(catalog), names(buildCatalog(entries, families))) << "trial " << trial;
+    }
+  }
+
+  const FamilyMix mix = defaultFamilyMix();
+  const auto catalog = buildCatalog(1400, mix.families, mix.weights);
+  std::map<Family, int> perFamily;
+  for (const ShapeSpec& s : catalog)
+    ++perFamily[s.family];
+  EXPECT_EQ(perFamily[Family::kFragment], 280);
+  EXPECT_EQ(perFamily[Family::kShard], 140);
+  EXPECT_EQ(perFamily[Family::kBox], 70);
+  EXPECT_EQ(perFamily[Family::kUnion], 70);
+}
+
+TEST(Families, AFamilyMixReadsWeightsAndNamesABadOne) {
+  auto mix = parseFamilyMix("box,fragment:3,ring:100");
+  ASSERT_TRUE(mix.ok()) << mix.error().message;
+  EXPECT_EQ(mix->families, (std::vector<Family>{Family::kBox, Family::kFragment, Family::kRing}));
+  EXPECT_EQ(mix->weights, (std::vector<unsigned>{1, 3, 100}));
+  EXPECT_EQ(toString(*mix), "box,fragment:3,ring:100");
+  auto all = parseFamilyMix("all");
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all->families.size(), 16u);
+  EXPECT_EQ(toString(*all), "all");
+  EXPECT_EQ(parseFamilyMix(toString(*all))->weights, defaultFamilyMix().weights);
+  for (const char* bad : {"box:0", "box:101", "box:", "box:1.5", "box:-1", "box:2x"}) {
+    auto refused = parseFamilyMix(bad);
+    ASSERT_FALSE(refused.ok()) << bad;
+    EXPECT_NE(refused.error().message.find("weight of 'box'"), std::string::npos) << refused.error().message;
+  }
+  EXPECT_FALSE(parseFamilyMix("box:2,box").ok());
+  EXPECT_FALSE(parseFamilies("box:2").ok());  // where weights mean nothing, they are refused
+  EXPECT_TRUE(validFamilyWeights(2, std::vector<unsigned>{}));
+  EXPECT_FALSE(validFamilyWeights(2, std::vector<unsigned>{1}));
+  EXPECT_FALSE(validFamilyWeights(1, std::vector<unsigned>{0}));
 }
 
 TEST(Families, ParseFamiliesNamesTheBadOne) {

@@ -1,10 +1,14 @@
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <random>
+#include <string>
+#include <system_error>
 
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/topology.h>
@@ -222,12 +226,27 @@ std::optional<Family> parseFamily(std::string_view name) {
   return std::nullopt;
 }
 
-Result<std::vector<Family>> parseFamilies(std::string_view list) {
-  if (list == "all") return std::vector<Family>(kGenerated.begin(), kGenerated.end());
-  std::vector<Family> families;
+unsigned defaultFamilyWeight(Family family) {
+  return family == Family::kFragment ? 4 : family == Family::kShard ? 2 : 1;
+}
+
+FamilyMix defaultFamilyMix() {
+  FamilyMix mix;
+  for (Family f : kGenerated) {
+    mix.families.push_back(f);
+    mix.weights.push_back(defaultFamilyWeight(f));
+  }
+  return mix;
+}
+
+Result<FamilyMix> parseFamilyMix(std::string_view list) {
+  if (list == "all") return defaultFamilyMix();
+  FamilyMix mix;
   while (!list.empty()) {
     const std::size_t comma = list.find(',');
-    const std::string_view name = list.substr(0, comma);
+    const std::string_view item = list.substr(0, comma);
+    const std::size_t colon = item.find(':');
+    const std::string_view name = item.substr(0, colon);
     const std::optional<Family> f = parseFamily(name);
     if (!f || *f == Family::kUser || *f == Family::kLearned) {
       std::string known;
@@ -236,13 +255,54 @@ Result<std::vector<Family>> parseFamilies(std::string_view list) {
       return Error{ErrorCode::kInvalidArgument,
                    "unknown family '" + std::string(name) + "' (known: " + known + ")"};
     }
-    if (std::find(families.begin(), families.end(), *f) != families.end())
+    if (std::find(mix.families.begin(), mix.families.end(), *f) != mix.families.end())
       return Error{ErrorCode::kInvalidArgument, "family '" + std::string(name) + "' is listed twice"};
-    families.push_back(*f);
+    unsigned weight = 1;
+    if (colon != std::string_view::npos) {
+      const std::string_view digits = item.substr(colon + 1);
+      const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), weight);
+      if (ec != std::errc{} || end != digits.data() + digits.size() || weight < 1 ||
+          weight > kMaxFamilyWeight)
+        return Error{ErrorCode::kInvalidArgument,
+                     "the weight of '" + std::string(name) + "' must be a whole number from 1 to " +
+                         std::to_string(kMaxFamilyWeight) + ", not '" + std::string(digits) + "'"};
+    }
+    mix.families.push_back(*f);
+    mix.weights.push_back(weight);
     list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
   }
-  if (families.empty()) return Error{ErrorCode::kInvalidArgument, "no family given"};
-  return families;
+  if (mix.families.empty()) return Error{ErrorCode::kInvalidArgument, "no family given"};
+  return mix;
+}
+
+Result<std::vector<Family>> parseFamilies(std::string_view list) {
+  if (list.find(':') != std::string_view::npos)
+    return Error{ErrorCode::kInvalidArgument,
+                 "a family list here takes no weights ('" + std::string(list) + "')"};
+  auto mix = parseFamilyMix(list);
+  if (!mix) return mix.error();
+  return std::move(mix->families);
+}
+
+bool validFamilyWeights(std::size_t families, std::span<const unsigned> weights) {
+  return weights.empty() || (weights.size() == families && std::ranges::all_of(weights, [](unsigned w) {
+                               return w >= 1 && w <= kMaxFamilyWeight;
+                             }));
+}
+
+std::string toString(const FamilyMix& mix) {
+  const FamilyMix all = defaultFamilyMix();
+  if (mix.families == all.families && mix.weights == all.weights) return "all";
+  std::string text;
+  for (std::size_t f = 0; f < mix.families.size(); ++f) {
+    if (!text.empty()) text += ',';
+    text += toString(mix.families[f]);
+    if (f < mix.weights.size() && mix.weights[f] != 1) {
+      text += ':';
+      text += std::to_string(mix.weights[f]);
+    }
+  }
+  return text;
 }
 
 std::string ShapeSpec::name() const {
@@ -341,15 +401,32 @@ ShapeSpec familySpec(Family family, std::uint32_t index) {
   return spec;
 }
 
-std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family> families) {
+std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family> families,
+                                    std::span<const unsigned> weights) {
   std::vector<ShapeSpec> catalog;
   if (families.empty()) return catalog;
-  catalog.reserve(entries);
+  const auto weightOf = [&](std::size_t f) -> std::size_t { return weights.empty() ? 1 : weights[f]; };
+  std::size_t total = 0;
+  for (std::size_t f = 0; f < families.size(); ++f)
+    total += weightOf(f);
+  // Largest remainders: each family's whole share, then one more to the largest fractions (the share's
+  // remainder over the total weight), the earlier family first among equals.
+  std::vector<std::size_t> counts(families.size()), order(families.size());
+  std::size_t given = 0;
   for (std::size_t f = 0; f < families.size(); ++f) {
-    const std::size_t count = entries / families.size() + (f < entries % families.size() ? 1 : 0);
-    for (std::size_t i = 0; i < count; ++i)
-      catalog.push_back(familySpec(families[f], static_cast<std::uint32_t>(i)));
+    counts[f] = entries / total * weightOf(f) + entries % total * weightOf(f) / total;
+    given += counts[f];
   }
+  const auto fraction = [&](std::size_t f) { return entries % total * weightOf(f) % total; };
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t x, std::size_t y) { return fraction(x) > fraction(y); });
+  for (std::size_t k = 0; given < entries; ++k, ++given)
+    ++counts[order[k]];
+  catalog.reserve(entries);
+  for (std::size_t f = 0; f < families.size(); ++f)
+    for (std::size_t i = 0; i < counts[f]; ++i)
+      catalog.push_back(familySpec(families[f], static_cast<std::uint32_t>(i)));
   return catalog;
 }
 

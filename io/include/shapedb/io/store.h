@@ -33,7 +33,10 @@ struct BuildParameters {
   /// Surface resolution of the curved families (entryResolution of the entry's elements).
   volume::ShapeResolution resolution = entryResolution(volume::ElementOrder::kQuadratic);
   std::vector<volume::Family> families;  ///< of the generated catalog
-  std::size_t entries = 1100;            ///< size of the generated catalog
+  /// Each family's share of the catalog (volume::buildCatalog), as many as families; empty: even (the
+  /// files built before weights existed).
+  std::vector<unsigned> weights;
+  std::size_t entries = 1400;  ///< size of the generated catalog
 };
 
 /// `parameters` for a database of `order` elements: the entry's elements and TetGen bounds

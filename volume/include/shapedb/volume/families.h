@@ -49,8 +49,34 @@ std::span<const Family> convexFamilies();
 const char* toString(Family family);
 std::optional<Family> parseFamily(std::string_view name);
 /// A comma-separated list of family names ("box,cone"); "all" for generatedFamilies().
-/// Errors: kInvalidArgument naming the unknown family, or for "user" (not generated) or duplicates.
+/// Errors: kInvalidArgument naming the unknown family, or for "user" (not generated) or duplicates, or
+/// for a weight (parseFamilyMix reads those).
 Result<std::vector<Family>> parseFamilies(std::string_view list);
+
+/// The families of a catalog and each one's weight: its share of the entries relative to the others'
+/// (a family of weight 2 gets twice the entries of one of weight 1).
+struct FamilyMix {
+  std::vector<Family> families;
+  std::vector<unsigned> weights;  ///< as many as families, each in [1, kMaxFamilyWeight]
+};
+inline constexpr unsigned kMaxFamilyWeight = 100;
+
+/// The default catalog's mix: every generated family, fragments weighted 4 and shards 2, the others 1.
+/// What fracture breaks off is what a database is asked for most often, in bursts of hundreds, and those
+/// two families span more than the others (a fragment has its solid, its proportions, its number of
+/// seeds and the seeds themselves; a shard its cuts), so they need more entries to be covered as closely.
+FamilyMix defaultFamilyMix();
+/// A family's weight in defaultFamilyMix().
+unsigned defaultFamilyWeight(Family family);
+/// Whether `weights` can weigh `families` families: none (even), or one each in [1, kMaxFamilyWeight].
+bool validFamilyWeights(std::size_t families, std::span<const unsigned> weights);
+/// "box,fragment:3": family names, each with an optional weight (1 unless given); "all" for
+/// defaultFamilyMix(). Errors as parseFamilies, and kInvalidArgument for a weight that is not a whole
+/// number in [1, kMaxFamilyWeight].
+Result<FamilyMix> parseFamilyMix(std::string_view list);
+/// "box,fragment:3": the mix as parseFamilyMix reads it (weights of 1 left out; all of defaultFamilyMix()
+/// as "all").
+std::string toString(const FamilyMix& mix);
 
 /// One generated shape: its family and where it sits in the family's sweep. Deterministic: the same spec
 /// always gives the same mesh.
@@ -99,9 +125,12 @@ struct ShapeSpec {
 /// The index-th spec of a family's sweep.
 ShapeSpec familySpec(Family family, std::uint32_t index);
 
-/// About `entries` specs spread evenly over `families` (the first families take the remainder), in a
-/// fixed order: family by family, each family's sweep from index 0.
-std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family> families);
+/// `entries` specs shared out over `families` in proportion to their `weights` (empty: evenly), in a
+/// fixed order: family by family, each family's sweep from index 0. Each family gets the whole part of
+/// its share; what is left goes one entry each to the largest fractions, the first family first among
+/// equals (so an even catalog gives the remainder to the first families, as it always did).
+std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family> families,
+                                    std::span<const unsigned> weights = {});
 
 /// Surface resolution of curved families.
 struct ShapeResolution {
