@@ -66,6 +66,7 @@ nlohmann::json matchJson(const io::MatchReport& m) {
                        {"max_deviation", f.maxDeviation},
                        {"samples", f.samples}};
   }
+  if (m.predictedFrequencyError) out["predicted_frequency_error"] = *m.predictedFrequencyError;
   return out;
 }
 

@@ -2,8 +2,18 @@
 #include <cmath>
 
 #include <shapedb/core/error_model.h>
+#include <shapedb/core/fidelity.h>
 
 namespace shapedb::core {
+
+ErrorEvidence evidenceOf(const Fidelity& f) {
+  ErrorEvidence e;
+  e.meanDeviation = f.meanDeviation;
+  e.maxDeviation = f.maxDeviation;
+  e.maxMomentError = f.maxMomentError;
+  e.descriptorDistance = f.descriptorDistance;
+  return e;
+}
 
 ErrorFeatures errorFeatures(const ErrorEvidence& e) {
   const auto ln = [](double x, double floor) { return std::log(std::max(x, 0.0) + floor); };

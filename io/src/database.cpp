@@ -457,15 +457,11 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       m.fidelity = core::assessFidelity(mesh, queryTree, out.normalization, entries[i]->locator,
                                         entries[i]->data.massProperties, placement,
                                         m.match.distance - m.match.momentTerm, options.fidelityOptions);
+      m.predictedFrequencyError = core::predictFrequencyError(core::evidenceOf(*m.fidelity));
     }
     out.times.fidelity = microsecondsSince(t);
     if (out.physics && options.link && !mesh.vertices.empty()) {
-      const core::Fidelity& f = *out.answeredMatch().fidelity;
-      core::ErrorEvidence evidence;
-      evidence.meanDeviation = f.meanDeviation;
-      evidence.maxDeviation = f.maxDeviation;
-      evidence.maxMomentError = f.maxMomentError;
-      evidence.descriptorDistance = f.descriptorDistance;
+      core::ErrorEvidence evidence = core::evidenceOf(*out.answeredMatch().fidelity);
       evidence.outsideShare =
           static_cast<double>(out.link.outsideCount) / static_cast<double>(mesh.vertices.size());
       if (out.correction) evidence.morphTargetDistance = out.correction->morph.meanTargetDistance;

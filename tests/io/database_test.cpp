@@ -249,6 +249,13 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     EXPECT_LT(f.maxDeviation, sampled ? 1e-2 : 1e-6)
         << e.name << ": the placed tets' boundary is the query's surface";
     EXPECT_GT(r->matches[1].fidelity->meanDeviation, f.meanDeviation) << e.name;
+    // Every match's own estimate, from its fidelity report: the worse match is predicted worse.
+    for (const MatchReport& m : r->matches) {
+      ASSERT_TRUE(m.predictedFrequencyError) << e.name;
+      EXPECT_DOUBLE_EQ(*m.predictedFrequencyError,
+                       core::predictFrequencyError(core::evidenceOf(*m.fidelity)));
+    }
+    EXPECT_GT(*r->matches[1].predictedFrequencyError, *r->matches[0].predictedFrequencyError) << e.name;
 
     // Scaling laws against the query's own size L and the material.
     ASSERT_TRUE(r->physics.has_value());

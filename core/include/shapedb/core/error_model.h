@@ -19,6 +19,11 @@ struct ErrorEvidence {
   std::optional<double> morphTargetDistance;
 };
 
+struct Fidelity;
+
+/// The evidence of a fidelity report alone (no link, not corrected).
+ErrorEvidence evidenceOf(const Fidelity& fidelity);
+
 inline constexpr int kErrorFeatures = 7;
 using ErrorFeatures = std::array<double, kErrorFeatures>;
 

@@ -85,6 +85,11 @@ struct MatchReport {
   core::Match match;
   const EntryRecord* entry = nullptr;  ///< owned by the Database
   std::optional<core::Fidelity> fidelity;
+  /// With fidelity: how wrong this match's own data, uncorrected, would probably make the first non-rigid
+  /// frequency (core/error_model.h's nearest-entry estimate on this match's fidelity report; the link's
+  /// share of outside vertices is known for the answered match only, and counts as 0 here). Ranks the
+  /// candidates; the answer's own estimate is QueryResult::predictedFrequencyError.
+  std::optional<double> predictedFrequencyError{};
 };
 
 /// Everything a query found: the query's own mass properties (unit density) and frame, the k best
