@@ -21,7 +21,7 @@ struct MorphOptions {
   /// their closest boundary points), with a fit weight that grows round by round from stiff to close.
   /// The second direction is what carries the boundary into the target's protrusions (a limb the entry
   /// lacks), where closest points alone would never go. 0: projection only.
-  int registrationRounds = 4;
+  int registrationRounds = 8;
   /// The boundary's displacement is carried into the interior in one increment or, where that would push a
   /// tet under minQuality, in this many (the mesh-motion stiffness assembled again before each).
   int maxIncrements = 8;
