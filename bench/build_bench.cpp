@@ -2,8 +2,7 @@
 // Targets on the 2-core reference machine: the default database (1,400 entries, 20 modes) in <= 10 min,
 // i.e. >= 2.33 entries/s on 2 threads; the demo's database in <= 2 min.
 //   build/release/bin/build_bench
-// Each run builds a 64-entry catalog of the default mix (every family, fragments and shards weighted)
-// into a fresh file.
+// Each run builds a 64-entry catalog of the default mix (every family, 4 of each) into a fresh file.
 // Counters: entries_per_s (wall), <stage>_ms (mean CPU-time per entry: tetrahedralize, modes, collision,
 // describe), kib_per_entry (file size over entries), target_entries_per_s.
 

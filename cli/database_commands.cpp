@@ -350,11 +350,7 @@ Command addBuildCommand(CLI::App& parent) {
          "--families", o->families,
          "Comma-separated families, each with an optional weight: its share of the entries relative to\n"
          "the others' (\"box,fragment:3\": three fragments to a box; 1 unless given). Or all: the sixteen,\n"
-         "fragments weighted " +
-             std::to_string(volume::defaultFamilyWeight(volume::Family::kFragment)) + " and shards " +
-             std::to_string(volume::defaultFamilyWeight(volume::Family::kShard)) +
-             " (what fracture breaks off, asked for in bursts, spans more\nshapes than the others). "
-             "Convex (the catalog of older databases):\n" +
+         "evenly. Convex (the catalog of older databases):\n" +
              join(convex) +
              ".\nWith the handles, hooks, webs, holes, cavities, limbs and lumps of real objects:\n" +
              join(all.subspan(convex.size())))

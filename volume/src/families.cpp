@@ -226,16 +226,10 @@ std::optional<Family> parseFamily(std::string_view name) {
   return std::nullopt;
 }
 
-unsigned defaultFamilyWeight(Family family) {
-  return family == Family::kFragment ? 4 : family == Family::kShard ? 2 : 1;
-}
-
 FamilyMix defaultFamilyMix() {
   FamilyMix mix;
-  for (Family f : kGenerated) {
-    mix.families.push_back(f);
-    mix.weights.push_back(defaultFamilyWeight(f));
-  }
+  mix.families.assign(kGenerated.begin(), kGenerated.end());
+  mix.weights.assign(kGenerated.size(), 1);
   return mix;
 }
 

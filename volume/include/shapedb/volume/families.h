@@ -61,13 +61,10 @@ struct FamilyMix {
 };
 inline constexpr unsigned kMaxFamilyWeight = 100;
 
-/// The default catalog's mix: every generated family, fragments weighted 4 and shards 2, the others 1.
-/// What fracture breaks off is what a database is asked for most often, in bursts of hundreds, and those
-/// two families span more than the others (a fragment has its solid, its proportions, its number of
-/// seeds and the seeds themselves; a shard its cuts), so they need more entries to be covered as closely.
+/// The default catalog's mix: every generated family, evenly (weight 1 each). Weighting fragments 4 and
+/// shards 2 was measured (docs/architecture.md, "How many of each"): no better on fracture fragments,
+/// and a convex fragment then won the correction's choice on a limbed real object.
 FamilyMix defaultFamilyMix();
-/// A family's weight in defaultFamilyMix().
-unsigned defaultFamilyWeight(Family family);
 /// Whether `weights` can weigh `families` families: none (even), or one each in [1, kMaxFamilyWeight].
 bool validFamilyWeights(std::size_t families, std::span<const unsigned> weights);
 /// "box,fragment:3": family names, each with an optional weight (1 unless given); "all" for
