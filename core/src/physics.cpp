@@ -2,6 +2,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <string>
 #include <tuple>
 
@@ -124,6 +125,37 @@ std::vector<BoundaryFace> boundaryFaces(const TetMesh& mesh) {
     i = j;
   }
   return out;
+}
+
+std::size_t faceConnectedPieces(const TetMesh& mesh) {
+  // Every face keyed by its sorted nodes; two equal keys in a row are a face two tets share: join them.
+  std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> faces;
+  faces.reserve(4 * mesh.tets.size());
+  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
+    const auto& [a, b, c, d] = mesh.tets[t];
+    for (std::array<std::uint32_t, 3> key :
+         {std::array{a, b, c}, std::array{a, b, d}, std::array{a, c, d}, std::array{b, c, d}}) {
+      std::sort(key.begin(), key.end());
+      faces.emplace_back(key, t);
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  std::vector<std::uint32_t> parent(mesh.tets.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  const auto root = [&](std::uint32_t x) {
+    while (parent[x] != x)
+      x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::size_t pieces = mesh.tets.size();
+  for (std::size_t i = 0; i + 1 < faces.size(); ++i) {
+    if (faces[i].first != faces[i + 1].first) continue;
+    const std::uint32_t x = root(faces[i].second), y = root(faces[i + 1].second);
+    if (x == y) continue;
+    parent[x] = y;
+    --pieces;
+  }
+  return pieces;
 }
 
 TriangleMesh boundarySurface(const TetMesh& mesh) {

@@ -13,6 +13,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/volume/entry.h>
 #include <shapedb/volume/families.h>
+#include <shapedb/volume/fracture.h>
 #include <shapedb/volume/tetrahedralize.h>
 
 namespace shapedb::volume {
@@ -61,6 +62,56 @@ TEST(Tetrahedralize, AnEntrysTetsAreValidInTheCanonicalFrame) {
   ASSERT_TRUE(entry.ok()) << entry.error().message;
   const Status valid = core::validateTetMesh(entry->physics.tetMesh);
   EXPECT_TRUE(valid.ok()) << valid.error().message;
+}
+
+TEST(Tetrahedralize, TetsHeldByAnEdgeOrANodeAloneArePiecesOfTheirOwn) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0),    Vec3(0, 1, 0),   Vec3(0, 0, 1),  Vec3(1, 1, 1),
+                Vec3(2, 0, 1), Vec3(-1, -1, -1), Vec3(-1, 0, -1), Vec3(0, -1, -1)};
+  EXPECT_EQ(core::faceConnectedPieces(mesh), 0u);
+  mesh.tets = {{0, 1, 2, 3}, {1, 2, 3, 4}};  // sharing the face (1, 2, 3)
+  EXPECT_EQ(core::faceConnectedPieces(mesh), 1u);
+  mesh.tets.push_back({1, 3, 4, 5});  // sharing the face (1, 3, 4) with the second
+  EXPECT_EQ(core::faceConnectedPieces(mesh), 1u);
+  mesh.tets = {{0, 1, 2, 3}, {1, 3, 5, 4}};  // the edge (1, 3) only
+  EXPECT_EQ(core::faceConnectedPieces(mesh), 2u);
+  mesh.tets.push_back({0, 6, 7, 8});  // and one by the node 0 only
+  EXPECT_EQ(core::faceConnectedPieces(mesh), 3u);
+}
+
+// A 40 × 30 × 2 cm plate broken into 50 (seed 1, 800 triangles, as `shapedb bench --fracture` does).
+// Fragment 16's tets were one piece in TetGen's frame, but the move to the canonical frame flattened five
+// whose dropping left a part held by an edge: its entry rang at 18 Hz, then 11.5 kHz (the finer direct
+// computation's first mode). Fragment 46 lost 282 flat tets between nearly coplanar facets and fell into
+// five pieces: 1 kHz instead of ~17. Now each entry is one piece without a near-zero mode, or refused.
+TEST(Tetrahedralize, FragmentsOfAPlateHaveNoMechanism) {
+  FractureOptions fracturing;
+  fracturing.pieces = 50;
+  fracturing.maxTriangles = 800;
+  core::TriangleMesh plate;  // the benchmark's plate file, triangle for triangle (the fragments depend on it)
+  plate.vertices = {Vec3(-0.2, -0.15, -0.01), Vec3(0.2, -0.15, -0.01), Vec3(0.2, 0.15, -0.01),
+                    Vec3(-0.2, 0.15, -0.01),  Vec3(-0.2, -0.15, 0.01), Vec3(0.2, -0.15, 0.01),
+                    Vec3(0.2, 0.15, 0.01),    Vec3(-0.2, 0.15, 0.01)};
+  plate.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                     {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  auto broken = fracture(plate, fracturing);
+  ASSERT_TRUE(broken.ok()) << broken.error().message;
+  ASSERT_GT(broken->fragments.size(), 46u);
+  EntryOptions options = withElements(EntryOptions{}, ElementOrder::kQuadratic);
+  options.modal.modes = 3;
+  int computed = 0;
+  for (std::size_t i : {std::size_t{16}, std::size_t{46}}) {
+    auto entry = computeEntry(broken->fragments[i], options);
+    if (!entry) {
+      std::printf("fragment %zu refused: %s\n", i, entry.error().message.c_str());
+      continue;
+    }
+    ++computed;
+    EXPECT_EQ(core::faceConnectedPieces(entry->physics.tetMesh), 1u) << "fragment " << i;
+    const Eigen::VectorXd hz = entry->physics.modes.frequenciesHz();
+    EXPECT_GT(hz[0], hz[1] / 20.0) << "fragment " << i << ": a near-zero mode";
+  }
+  EXPECT_GE(computed, 1);
 }
 
 TEST(Tetrahedralize, GuardedAndInProcessGiveTheSameMesh) {

@@ -68,6 +68,13 @@ Result<EntryData> computeEntry(const core::TriangleMesh& surface, const EntryOpt
   // What the database stores must pass its reader's checks in this frame (fragment-00502 had a tet
   // flattened by the move): the nearly flat ones go, and the fill check below still holds the rest.
   dropFlatTets(entry.physics.tetMesh);
+  if (core::faceConnectedPieces(entry.physics.tetMesh) > 1) {
+    // Dropping them left tets held by an edge or a node alone (a mechanism: a plate fragment rang at
+    // 18 Hz instead of 11 kHz). The canonical surface meshed as it is has nothing to flatten.
+    auto direct = tetrahedralize(canonical, options.tetgen);
+    if (!direct) return withContext(direct.error(), "tetrahedralize (in the canonical frame)");
+    entry.physics.tetMesh = std::move(direct).value();
+  }
   if (Status valid = core::validateTetMesh(entry.physics.tetMesh); !valid)
     return Error{ErrorCode::kParse, "tetrahedralize: in the canonical frame, " + valid.error().message};
   entry.physics.massProperties = core::computeTetMassProperties(entry.physics.tetMesh);

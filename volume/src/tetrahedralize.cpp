@@ -70,6 +70,13 @@ Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const Tetrahedra
   dropFlatTets(mesh);
   if (Status valid = core::validateTetMesh(mesh); !valid)
     return Error{ErrorCode::kParse, "TetGen returned an invalid mesh: " + valid.error().message};
+  // Flat tets dropped between nearly coplanar facets can leave tets held by an edge or a node alone: a
+  // mechanism, which would ring at a near-zero frequency (a plate fragment did, at 1 kHz instead of 17).
+  // Refused here, so that the runs below try again without merging facets and with looser bounds.
+  if (const std::size_t pieces = core::faceConnectedPieces(mesh); pieces > 1)
+    return Error{ErrorCode::kParse, "TetGen's tets make " + std::to_string(pieces) +
+                                        " pieces joined only at edges or nodes once its flat tets are "
+                                        "dropped (a mechanism, which would ring at a near-zero frequency)"};
   const core::MassProperties filled = core::computeTetMassProperties(mesh);
   if (std::abs(filled.volume - volume) > 1e-9 * volume ||
       (filled.centerOfMass - mass.centerOfMass).norm() > 1e-9 * std::cbrt(volume)) {

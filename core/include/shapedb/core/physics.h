@@ -63,6 +63,12 @@ std::vector<BoundaryFace> boundaryFaces(const TetMesh& mesh);
 /// it uses (renumbered). For a conforming mesh of a solid, a closed surface.
 TriangleMesh boundarySurface(const TetMesh& mesh);
 
+/// How many pieces the tets make when two tets are joined only through a face they share: 1 for a solid
+/// meshed properly, 0 for no tets. Tets held to the rest by an edge or a node alone turn about it at no
+/// strain, a mechanism that the modes of the mesh would ring as a near-zero frequency beyond the six rigid
+/// motions.
+std::size_t faceConnectedPieces(const TetMesh& mesh);
+
 /// Modes of vibration of the free body (K φ = λ M φ) for unit density and unit Young's modulus at the
 /// stated Poisson ratio, in the canonical (unit-volume) frame: ω' = √λ rad/s. The six rigid modes are
 /// dropped. Mode i is column i of `shapes`, 3 values per node (x, y, z), M-orthonormal: φᵢᵀ M φⱼ = δᵢⱼ.
