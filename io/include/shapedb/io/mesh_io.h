@@ -101,13 +101,12 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
 
 /// What saveMesh writes.
 struct SaveOptions {
-  bool binary = true;  ///< PLY only: binary little-endian (exact doubles) rather than ASCII
+  bool binary = true;  ///< PLY only: binary little-endian rather than ASCII (both exact)
 };
 
-/// Writes an OBJ or PLY file through OpenMesh, chosen by extension. OpenMesh's readers parse single
-/// precision, so a mesh read back matches to float precision (~6e-8 relative). Errors: kUnknownFormat,
-/// kIo, kInvalidArgument (a mesh that fails validateMesh, or a non-manifold one, which OpenMesh's
-/// kernel cannot hold). Thread-safe.
+/// Writes an OBJ or PLY file, chosen by extension, in double precision (OBJ: 17 significant digits; PLY:
+/// double properties), so that loadMesh reads back exactly the vertices written. Errors: kUnknownFormat,
+/// kIo, kInvalidArgument (a mesh that fails validateMesh). Thread-safe.
 Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& path,
                 const SaveOptions& options = {});
 
