@@ -21,6 +21,26 @@ endif()
 set(SHAPEDB_HAVE_BULLET ${BULLET_FOUND})
 message(STATUS "shapedb: rigid-body scenario (Bullet): ${BULLET_FOUND}")
 
+# Optional: the Python module (pybind11 and NumPy from Debian, for Debian's own interpreter: another
+# python3 first on PATH would not have them). Without them, everything else builds.
+option(SHAPEDB_WITH_PYTHON "Build the Python module if pybind11 and NumPy are found" ON)
+set(SHAPEDB_HAVE_PYTHON OFF)
+if(SHAPEDB_WITH_PYTHON)
+  if(NOT DEFINED Python_EXECUTABLE AND EXISTS /usr/bin/python3)
+    set(Python_EXECUTABLE /usr/bin/python3)
+  endif()
+  find_package(Python 3 QUIET COMPONENTS Interpreter Development.Module)
+  if(Python_FOUND)
+    find_package(pybind11 2.10 CONFIG QUIET)
+    execute_process(COMMAND ${Python_EXECUTABLE} -c "import numpy" RESULT_VARIABLE numpy_missing
+                    OUTPUT_QUIET ERROR_QUIET)
+    if(pybind11_FOUND AND numpy_missing EQUAL 0)
+      set(SHAPEDB_HAVE_PYTHON ON)
+    endif()
+  endif()
+endif()
+message(STATUS "shapedb: Python module (pybind11, NumPy): ${SHAPEDB_HAVE_PYTHON}")
+
 find_path(TETGEN_INCLUDE_DIR tetgen.h REQUIRED)
 find_library(TETGEN_LIBRARY NAMES tet REQUIRED)
 if(NOT TARGET TetGen::tet)
