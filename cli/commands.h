@@ -33,6 +33,7 @@ Command addDescribeCommand(CLI::App& parent);
 Command addBuildCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addAddCommand(CLI::App& parent);
+Command addMergeCommand(CLI::App& parent);
 Command addEnrichCommand(CLI::App& parent);
 Command addQueryCommand(CLI::App& parent);
 Command addHapticCommand(CLI::App& parent);

@@ -75,6 +75,7 @@ struct BuildCommandOptions {
   std::string sampling = "area";
   double poisson = 0.3;
   std::size_t batch = 16;
+  std::string shard;
   bool resume = false;
   bool quiet = false;
 };
@@ -84,6 +85,14 @@ int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
   options.threads = o.threads;
   options.batchSize = o.batch;
   options.resume = o.resume;
+  if (!o.shard.empty()) {
+    const Result<io::Shard> shard = io::parseShard(o.shard);
+    if (!shard) {
+      printError("--shard: " + shard.error().message);
+      return kExitUsage;
+    }
+    options.shard = *shard;
+  }
   io::BuildParameters& p = options.parameters;
   p.entries = o.entries;
   auto mix = volume::parseFamilyMix(o.families);
@@ -126,6 +135,8 @@ int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
     check("--grid", have.entry.descriptor.gridSize != p.entry.descriptor.gridSize);
     check("--sampling", have.entry.descriptor.sampling != p.entry.descriptor.sampling);
     check("--poisson", have.entry.modal.material.poissonRatio != p.entry.modal.material.poissonRatio);
+    const Result<io::Shard> stored = io::storedShard(*store);
+    check("--shard", !stored || *stored != options.shard);
     if (!conflict.empty()) {
       printError(o.path + ": was built with another " + conflict.substr(2) +
                  " (its parameters: " + io::toJson(have) + "); a resumed build keeps them");
@@ -186,6 +197,7 @@ void printCheck(const io::IntegrityReport& report) {
 /// What info reports of a database file.
 struct InfoSummary {
   std::string status, created;
+  std::string shard;  ///< "K/N" for a shard, empty for a whole catalog
   std::size_t entries = 0;
   std::vector<io::FailureRecord> failures;
   std::map<std::string, std::size_t> perFamily;
@@ -228,6 +240,7 @@ Result<InfoSummary> summarizeDatabase(const std::string& path, bool check) {
   s.buildSeconds = std::stod(store->meta("build_seconds").value_or("0"));
   s.status = store->meta("status").value_or("unknown");
   s.created = store->meta("created").value_or("");
+  s.shard = store->meta("shard").value_or("");
   s.parameters = store->parameters();
   return s;
 }
@@ -253,6 +266,7 @@ nlohmann::json infoJson(const std::string& path, const InfoSummary& s) {
                         {"build_seconds", s.buildSeconds},
                         {"mean_nodes", s.meanNodes},
                         {"mean_tets", s.meanTets}};
+  if (!s.shard.empty()) out["shard"] = s.shard;
   if (s.check) out["check"] = checkJson(*s.check);
   return out;
 }
@@ -261,6 +275,8 @@ void printInfo(const std::string& path, const InfoSummary& s) {
   const io::BuildParameters& p = s.parameters;
   std::printf("%s: shapedb database, schema %d, %s, created %s\n", path.c_str(), io::kSchemaVersion,
               s.status.c_str(), s.created.empty() ? "?" : s.created.c_str());
+  if (!s.shard.empty())
+    std::printf("shard %s of its catalog (join the shards with 'shapedb merge')\n", s.shard.c_str());
   std::printf("entries: %zu", s.entries);
   for (const auto& [family, count] : s.perFamily)
     std::printf("  %s %zu", family.c_str(), count);
@@ -380,6 +396,11 @@ Command addBuildCommand(CLI::App& parent) {
   app->add_option("--batch", o->batch, "Entries per transaction")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  app->add_option(
+      "--shard", o->shard,
+      "Build only part K of N of the catalog (K from 0 to N-1: the entries whose index is K mod N),\n"
+      "into a file of its own, as a Slurm array task or a Kubernetes indexed job would; then\n"
+      "'shapedb merge' joins the N files into the database one build would have made");
   app->add_flag("--resume", o->resume, "Continue an interrupted build of DB with its own parameters");
   app->add_flag("--quiet", o->quiet, "No progress output");
   return {app, [o, app] { return runBuild(*o, *app); }};
@@ -397,6 +418,43 @@ Command addInfoCommand(CLI::App& parent) {
                 "Also check the whole file: SQLite's integrity check, and every blob against its checksum\n"
                 "(a damaged entry is named; exit status 1 if anything is damaged)");
   return {app, [o] { return runInfo(*o); }};
+}
+
+struct MergeOptions {
+  std::string out;
+  std::vector<std::string> shards;
+  bool quiet = false;
+};
+
+int runMerge(const MergeOptions& o) {
+  const std::vector<std::filesystem::path> shards(o.shards.begin(), o.shards.end());
+  const bool terminal = isatty(fileno(stderr)) != 0;
+  const auto progress = [&](std::size_t done, std::size_t total) {
+    if (!o.quiet && terminal) std::fprintf(stderr, "\rmerge: %zu/%zu entries", done, total);
+  };
+  const Result<io::MergeReport> report = io::mergeDatabases(o.out, shards, progress);
+  if (!o.quiet && terminal) std::fprintf(stderr, "\n");
+  if (!report) {
+    printError(report.error().message);
+    return report.error().code == ErrorCode::kInvalidArgument ? kExitUsage : kExitInputError;
+  }
+  std::printf("%s: %zu entries and %zu failures from %zu shards, in %s\n", o.out.c_str(), report->entries,
+              report->failures, report->shards, formatDuration(report->seconds).c_str());
+  return kExitOk;
+}
+
+Command addMergeCommand(CLI::App& parent) {
+  auto o = std::make_shared<MergeOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "merge",
+      "Join the shards of one catalog (each built with 'build --shard K/N', all N of them, complete) into\n"
+      "a new database file: the database a single build with the same parameters would have made, entry\n"
+      "for entry and byte for byte. Shards of other parameters, a part given twice or missing, or an\n"
+      "unfinished shard are refused. OUT appears only when whole.");
+  app->add_option("OUT", o->out, "Database file to create")->required();
+  app->add_option("SHARD", o->shards, "The shard files, in any order")->required();
+  app->add_flag("--quiet", o->quiet, "No progress output");
+  return {app, [o] { return runMerge(*o); }};
 }
 
 Command addAddCommand(CLI::App& parent) {

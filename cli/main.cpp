@@ -22,10 +22,11 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("shapedb " SHAPEDB_VERSION " (OpenVDB ") +
                                         shapedb::volume::openVdbVersion() + ")");
   app.require_subcommand(1);
-  std::vector<Command> commands = {addInspectCommand(app), addDescribeCommand(app), addBuildCommand(app),
-                                   addInfoCommand(app),    addAddCommand(app),      addEnrichCommand(app),
-                                   addQueryCommand(app),   addHapticCommand(app),   addFractureCommand(app),
-                                   addBenchCommand(app),   addSoundCommand(app),    addDropCommand(app)};
+  std::vector<Command> commands = {addInspectCommand(app),  addDescribeCommand(app), addBuildCommand(app),
+                                   addInfoCommand(app),     addAddCommand(app),      addMergeCommand(app),
+                                   addEnrichCommand(app),   addQueryCommand(app),    addHapticCommand(app),
+                                   addFractureCommand(app), addBenchCommand(app),    addSoundCommand(app),
+                                   addDropCommand(app)};
 
   try {
     app.parse(argc, argv);

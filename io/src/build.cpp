@@ -5,6 +5,7 @@
 #include <ctime>
 #include <set>
 
+#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
@@ -82,6 +83,41 @@ void addTimes(volume::StageTimes& sum, const volume::StageTimes& t) {
 
 }  // namespace
 
+Result<Shard> parseShard(std::string_view text) {
+  const std::size_t slash = text.find('/');
+  const auto number = [](std::string_view digits) -> std::optional<std::size_t> {
+    if (digits.empty() || digits.size() > 7) return std::nullopt;
+    std::size_t value = 0;
+    for (char c : digits) {
+      if (c < '0' || c > '9') return std::nullopt;
+      value = 10 * value + static_cast<std::size_t>(c - '0');
+    }
+    return value;
+  };
+  const auto k = slash == std::string_view::npos ? std::nullopt : number(text.substr(0, slash));
+  const auto n = slash == std::string_view::npos ? std::nullopt : number(text.substr(slash + 1));
+  if (!k || !n)
+    return Error{ErrorCode::kInvalidArgument,
+                 "shard '" + std::string(text) + "' is not K/N (say 0/4: the first of four)"};
+  if (*n < 1 || *n > 1000000 || *k >= *n)
+    return Error{ErrorCode::kInvalidArgument,
+                 "shard '" + std::string(text) + "': N from 1 to 1,000,000 and K from 0 to N − 1"};
+  return Shard{*k, *n};
+}
+
+std::string toString(const Shard& shard) {
+  return std::to_string(shard.index) + "/" + std::to_string(shard.count);
+}
+
+Result<Shard> storedShard(const Store& store) {
+  const std::optional<std::string> text = store.meta("shard");
+  if (!text) return Shard{};
+  Result<Shard> shard = parseShard(*text);
+  if (!shard)
+    return Error{ErrorCode::kParse, store.path().string() + ": unreadable shard: " + shard.error().message};
+  return shard;
+}
+
 Result<BuildReport> buildDatabase(const std::filesystem::path& path, const BuildOptions& options) {
   const auto start = Clock::now();
   std::optional<Store> opened;
@@ -94,13 +130,22 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
     opened.emplace(std::move(store).value());
   } else {
     if (Status st = validateParameters(options.parameters); !st) return st.error();
+    if (options.shard.count == 0 || options.shard.index >= options.shard.count)
+      return Error{ErrorCode::kInvalidArgument, "shard " + toString(options.shard) + ": K must be below N"};
     auto store = Store::create(path, options.parameters);
     if (!store) return store.error();
     opened.emplace(std::move(store).value());
     if (Status st = opened->setMeta("created", utcNow()); !st) return st.error();
+    if (!options.shard.whole())
+      if (Status st = opened->setMeta("shard", toString(options.shard)); !st) return st.error();
   }
   Store& store = *opened;
   const BuildParameters& p = store.parameters();
+  const Result<Shard> shard = storedShard(store);
+  if (!shard) return shard.error();
+  if (options.resume && !options.shard.whole() && options.shard != *shard)
+    return Error{ErrorCode::kInvalidArgument, path.string() + " holds shard " + toString(*shard) +
+                                                  " of its catalog, not " + toString(options.shard)};
   if (Status st = store.setMeta("status", "building"); !st) return st.error();
 
   // What is left to do: catalog entries neither stored nor recorded as failed.
@@ -115,11 +160,15 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
     done.insert(f.name);
   const std::vector<volume::ShapeSpec> catalog = volume::buildCatalog(p.entries, p.families, p.weights);
   std::vector<std::size_t> todo;
-  for (std::size_t i = 0; i < catalog.size(); ++i)
+  std::size_t part = 0;
+  for (std::size_t i = 0; i < catalog.size(); ++i) {
+    if (!shard->holds(i)) continue;
+    ++part;
     if (!done.count(catalog[i].name())) todo.push_back(i);
+  }
 
   BuildReport report;
-  report.skipped = catalog.size() - todo.size();
+  report.skipped = part - todo.size();
   BuildProgress progress;
   progress.total = todo.size();
   progress.skipped = report.skipped;
@@ -188,6 +237,148 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
   if (Status st = store.setMeta("status", "complete"); !st) return st.error();
   // Best effort: a reader holding the file open keeps it in WAL mode, which is as valid.
   static_cast<void>(store.finish());
+  return report;
+}
+
+namespace {
+
+/// One shard file opened for a merge, with what the merge checks of it.
+struct ShardFile {
+  std::filesystem::path path;
+  Store store;
+  Shard shard;
+  std::vector<EntryRecord> entries;
+  std::vector<FailureRecord> failures;
+};
+
+/// "families [...] against [...]; modes ...": the parameters (toJson) that differ, by their top-level keys.
+std::string parameterDifference(const std::string& a, const std::string& b) {
+  const nlohmann::json x = nlohmann::json::parse(a), y = nlohmann::json::parse(b);
+  std::string out;
+  for (const auto& [key, value] : x.items())
+    if (!y.contains(key) || y.at(key) != value)
+      out += (out.empty() ? "" : "; ") + key + " " + value.dump() + " against " +
+             (y.contains(key) ? y.at(key).dump() : std::string("none"));
+  return out;
+}
+
+Result<ShardFile> openShard(const std::filesystem::path& path) {
+  Result<Store> store = Store::open(path);
+  if (!store) return store.error();
+  const Result<Shard> shard = storedShard(*store);
+  if (!shard) return shard.error();
+  const std::string status = store->meta("status").value_or("unknown");
+  if (status != "complete")
+    return Error{ErrorCode::kInvalidArgument, path.string() + ": not completely built (status '" + status +
+                                                  "'): finish it with `shapedb build " + path.string() +
+                                                  " --resume` first"};
+  auto entries = store->entries();
+  if (!entries) return entries.error();
+  auto failures = store->failures();
+  if (!failures) return failures.error();
+  for (const EntryRecord& r : *entries)
+    if (r.id >= store->parameters().entries || !shard->holds(r.id))
+      return Error{ErrorCode::kInvalidArgument,
+                   path.string() + ": entry '" + r.name + "' (id " + std::to_string(r.id) +
+                       ") is not of shard " + toString(*shard) +
+                       " of the catalog (an entry added by hand?): only catalog shards merge"};
+  return ShardFile{path, std::move(store).value(), *shard, std::move(entries).value(),
+                   std::move(failures).value()};
+}
+
+}  // namespace
+
+Result<MergeReport> mergeDatabases(const std::filesystem::path& out,
+                                   std::span<const std::filesystem::path> shards,
+                                   const std::function<void(std::size_t, std::size_t)>& progress) {
+  const auto start = Clock::now();
+  if (shards.empty()) return Error{ErrorCode::kInvalidArgument, "no shard to merge"};
+  std::error_code ec;
+  if (std::filesystem::exists(out, ec))
+    return Error{ErrorCode::kIo, out.string() + ": exists (a merge writes a new file)"};
+
+  // Every shard readable, complete and of the same catalog; every part there exactly once.
+  std::vector<ShardFile> parts;
+  for (const std::filesystem::path& path : shards) {
+    Result<ShardFile> part = openShard(path);
+    if (!part) return part.error();
+    parts.push_back(std::move(part).value());
+  }
+  const ShardFile& first = parts.front();
+  const std::string parameters = toJson(first.store.parameters());
+  std::vector<const ShardFile*> byIndex(first.shard.count, nullptr);
+  for (const ShardFile& part : parts) {
+    if (const std::string theirs = toJson(part.store.parameters()); theirs != parameters)
+      return Error{ErrorCode::kInvalidArgument, part.path.string() + ": built with other parameters than " +
+                                                    first.path.string() + " (" +
+                                                    parameterDifference(theirs, parameters) + ")"};
+    if (part.shard.count != first.shard.count)
+      return Error{ErrorCode::kInvalidArgument,
+                   part.path.string() + " is shard " + toString(part.shard) + " but " + first.path.string() +
+                       " is shard " + toString(first.shard) + ": shards of one catalog share N"};
+    if (const ShardFile* other = byIndex[part.shard.index])
+      return Error{ErrorCode::kInvalidArgument, other->path.string() + " and " + part.path.string() +
+                                                    " are both shard " + toString(part.shard) +
+                                                    ": they overlap"};
+    byIndex[part.shard.index] = &part;
+  }
+  std::string missing;
+  for (std::size_t k = 0; k < byIndex.size(); ++k)
+    if (!byIndex[k]) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+  if (!missing.empty())
+    return Error{ErrorCode::kInvalidArgument, "shard(s) " + missing + " of " +
+                                                  std::to_string(byIndex.size()) +
+                                                  " missing: a merge needs every part of the catalog"};
+
+  // Written beside `out` and renamed onto it once whole (a stale file of an interrupted merge is ours).
+  std::filesystem::path partial = out;
+  partial += ".merging";
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+    std::filesystem::remove(partial.string() + suffix, ec);
+  MergeReport report;
+  report.shards = parts.size();
+  {
+    Result<Store> created = Store::create(partial, first.store.parameters());
+    if (!created) return created.error();
+    Store& merged = *created;
+    std::size_t total = 0, done = 0;
+    double buildSeconds = 0.0;
+    std::vector<FailureRecord> failures;
+    for (const ShardFile& part : parts) {
+      total += part.entries.size();
+      buildSeconds += std::stod(part.store.meta("build_seconds").value_or("0"));
+      failures.insert(failures.end(), part.failures.begin(), part.failures.end());
+    }
+    const std::pair<const char*, std::string> meta[] = {
+        {"created", utcNow()}, {"status", "merging"}, {"build_seconds", std::to_string(buildSeconds)}};
+    for (const auto& [key, value] : meta)
+      if (Status st = merged.setMeta(key, value); !st) return st.error();
+    constexpr std::size_t kBatch = 64;
+    for (const ShardFile* part : byIndex) {
+      std::vector<core::EntryId> ids;
+      for (const EntryRecord& r : part->entries)
+        ids.push_back(r.id);
+      for (std::size_t at = 0; at < ids.size(); at += kBatch) {
+        const std::span<const core::EntryId> batch(ids.data() + at, std::min(kBatch, ids.size() - at));
+        if (Status st = merged.copyEntries(part->store, batch); !st) return st.error();
+        done += batch.size();
+        if (progress) progress(done, total);
+      }
+    }
+    if (Status st = merged.write({}, {}, failures); !st) return st.error();
+    if (Status st = merged.setMeta("status", "complete"); !st) return st.error();
+    static_cast<void>(merged.finish());
+    report.entries = total;
+    report.failures = failures.size();
+  }  // closed: a last connection's close also folds any write-ahead log into the file
+  for (const char* suffix : {"-wal", "-shm"})
+    if (std::filesystem::exists(partial.string() + suffix, ec))
+      return Error{ErrorCode::kIo, partial.string() + suffix + ": left over after closing; the merge is in " +
+                                       partial.string()};
+  std::filesystem::rename(partial, out, ec);
+  if (ec)
+    return Error{ErrorCode::kIo, out.string() + ": cannot rename the merged file onto it: " + ec.message()};
+  report.seconds = secondsSince(start);
   return report;
 }
 

@@ -118,6 +118,85 @@ TEST(BuildCli, KilledWithSigkillThenResumedEqualsACleanBuild) {
   EXPECT_NE(conflict.err.find("was built with another families"), std::string::npos) << conflict.err;
 }
 
+TEST(BuildCli, ShardsBuiltSeparatelyAndMergedEqualASingleBuild) {
+  test::ScratchDir dir("build-shards");
+  const std::vector<std::string> args = {"--entries", "14", "--families", "box,cone:2,shard",
+                                         "--modes",   "4",  "--quiet"};
+  const auto build = [&](const std::filesystem::path& file, std::vector<std::string> more) {
+    std::vector<std::string> argv = {"build", file.string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.insert(argv.end(), more.begin(), more.end());
+    const test::ProcessResult r = test::runProcess(SHAPEDB_CLI, argv);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+  };
+  build(dir / "whole.db", {});
+  for (int k = 0; k < 3; ++k)
+    build(dir / ("part" + std::to_string(k) + ".db"), {"--shard", std::to_string(k) + "/3"});
+  // Each shard holds its interleaved part (14 entries: 5, 5 and 4) and says which it is.
+  const nlohmann::json info = nlohmann::json::parse(
+      test::runProcess(SHAPEDB_CLI, {"info", (dir / "part2.db").string(), "--json"}).out);
+  EXPECT_EQ(info["shard"], "2/3");
+  EXPECT_EQ(info["entries"], 4);
+  // A shard resumed with another part is refused; with its own, there is nothing left to do.
+  test::ProcessResult r =
+      test::runProcess(SHAPEDB_CLI, {"build", (dir / "part1.db").string(), "--resume", "--shard", "0/3"});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("was built with another shard"), std::string::npos) << r.err;
+  r = test::runProcess(SHAPEDB_CLI, {"build", (dir / "part1.db").string(), "--resume", "--quiet"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("0 entries built, 0 failed, 5 already there"), std::string::npos) << r.out;
+
+  // Merged in any order: the single build's database, entry for entry and byte for byte.
+  r = test::runProcess(SHAPEDB_CLI, {"merge", (dir / "merged.db").string(), (dir / "part2.db").string(),
+                                     (dir / "part0.db").string(), (dir / "part1.db").string(), "--quiet"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("14 entries and 0 failures from 3 shards"), std::string::npos) << r.out;
+  expectSameEntries(dir / "merged.db", dir / "whole.db");
+  const nlohmann::json merged = nlohmann::json::parse(
+      test::runProcess(SHAPEDB_CLI, {"info", (dir / "merged.db").string(), "--json", "--check"}).out);
+  EXPECT_EQ(merged["status"], "complete");
+  EXPECT_FALSE(merged.contains("shard"));
+  EXPECT_TRUE(merged["check"]["ok"]);
+
+  // What cannot be merged is refused, naming the files, and leaves no output behind.
+  build(dir / "other.db", {"--shard", "2/3", "--poisson", "0.25"});
+  build(dir / "quarter.db", {"--shard", "3/4"});
+  const auto refused = [&](std::vector<std::string> shards, const std::string& why) {
+    SCOPED_TRACE(why);
+    std::vector<std::string> argv = {"merge", (dir / "refused.db").string()};
+    for (const std::string& shard : shards)
+      argv.push_back((dir / shard).string());
+    const test::ProcessResult m = test::runProcess(SHAPEDB_CLI, argv);
+    EXPECT_EQ(m.exitCode, 2);
+    EXPECT_NE(m.err.find(why), std::string::npos) << m.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "refused.db"));
+  };
+  refused({"part0.db", "part1.db"}, "shard(s) 2 of 3 missing");
+  refused({"part0.db", "part1.db", "part1.db", "part2.db"}, "are both shard 1/3: they overlap");
+  refused({"part0.db", "part1.db", "other.db"}, "other.db: built with other parameters than");
+  refused({"part0.db", "part1.db", "part2.db", "quarter.db"}, "is shard 3/4 but");
+  refused({"merged.db", "part0.db"}, "part0.db is shard 0/3 but");
+  refused({"whole.db", "merged.db"}, "are both shard 0/1: they overlap");
+  const test::ProcessResult exists =
+      test::runProcess(SHAPEDB_CLI, {"merge", (dir / "merged.db").string(), (dir / "part0.db").string()});
+  EXPECT_EQ(exists.exitCode, 1);
+  EXPECT_NE(exists.err.find("exists"), std::string::npos) << exists.err;
+
+  // A damaged blob in a shard is found on the way, named, and nothing is written.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir / "part2.db").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE physics SET data = X'00' WHERE entry_id = 2 AND part = 2", nullptr,
+                         nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  const test::ProcessResult damaged =
+      test::runProcess(SHAPEDB_CLI, {"merge", (dir / "refused.db").string(), (dir / "part0.db").string(),
+                                     (dir / "part1.db").string(), (dir / "part2.db").string(), "--quiet"});
+  EXPECT_EQ(damaged.exitCode, 1);
+  EXPECT_NE(damaged.err.find("physics part 2 does not match its checksum"), std::string::npos) << damaged.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "refused.db"));
+}
+
 TEST(BuildCli, AFullDiskFailsClearlyKeepsWhatWasCommittedAndTheBuildResumes) {
   test::ScratchDir dir("build-full");
   const auto full = dir / "full.db", clean = dir / "clean.db";

@@ -7,6 +7,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <shapedb/core/result.h>
@@ -27,8 +28,25 @@ struct BuildProgress {
   std::string lastName;
 };
 
+/// One of `count` disjoint parts of a catalog: the entries whose catalog index i has i mod count = index
+/// (interleaved, so that every part holds its share of each family and of the costly entries). A part is
+/// built into a file of its own, anywhere (a Slurm array task, a Kubernetes indexed job); mergeDatabases
+/// joins the parts into the database one build would have made.
+struct Shard {
+  std::size_t index = 0;  ///< 0 to count − 1
+  std::size_t count = 1;  ///< 1: the whole catalog
+  bool whole() const { return count == 1; }
+  bool holds(std::size_t catalogIndex) const { return catalogIndex % count == index; }
+  friend bool operator==(const Shard&, const Shard&) = default;
+};
+/// "K/N" (0 ≤ K < N ≤ 1,000,000), as toString writes it. Errors: kInvalidArgument saying what is wrong.
+Result<Shard> parseShard(std::string_view text);
+std::string toString(const Shard& shard);
+
 struct BuildOptions {
   BuildParameters parameters;  ///< for a new file; a resumed build uses the file's own
+  /// The part of the catalog to build (a new file records it; a resumed build continues the file's own).
+  Shard shard;
   int threads = 0;             ///< 0: all cores
   std::size_t batchSize = 16;  ///< entries per transaction: what a crash can cost
   /// Continue the build in an existing file: entries already in it (or recorded as failed) are skipped.
@@ -50,6 +68,27 @@ struct BuildReport {
 /// shape TetGen refuses, say) is recorded with its reason and the build goes on.
 /// Errors: kIo (file exists without resume, or missing with resume; disk), kInvalidArgument (parameters).
 Result<BuildReport> buildDatabase(const std::filesystem::path& path, const BuildOptions& options);
+
+/// The part a database file holds (its `shard` meta; a file without one holds the whole catalog).
+/// Errors: kParse for an unreadable value.
+Result<Shard> storedShard(const Store& store);
+
+/// What a merge did.
+struct MergeReport {
+  std::size_t entries = 0, failures = 0, shards = 0;
+  double seconds = 0.0;
+};
+
+/// Joins the shards of one catalog (each built with BuildOptions::shard, all complete) into a new file
+/// `out`: their entries with their ids, records and blobs as stored (checksums verified on the way),
+/// their failures, and the parameters they share: the database a single build with those parameters
+/// would have made, build times aside. Written beside `out` and renamed onto it at the end, so that `out`
+/// is whole or absent. Errors: kIo (`out` exists; a shard cannot be read), kInvalidArgument (shards of
+/// other parameters, other counts, one part twice or a part missing, a shard not completely built or
+/// holding entries outside its part: the message names the files), and Store's.
+Result<MergeReport> mergeDatabases(
+    const std::filesystem::path& out, std::span<const std::filesystem::path> shards,
+    const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 
 /// A user mesh to add: its surface and the name it goes by (the file's name, by default).
 struct NamedMesh {
