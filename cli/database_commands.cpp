@@ -12,6 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include <shapedb/io/database.h>
+#ifdef SHAPEDB_HAVE_MPI
+#include <shapedb/io/build_mpi.h>
+#endif
 #include <shapedb/io/mesh_io.h>
 #include <shapedb/volume/describe.h>
 #include <shapedb/volume/families.h>
@@ -76,6 +79,7 @@ struct BuildCommandOptions {
   double poisson = 0.3;
   std::size_t batch = 16;
   std::string shard;
+  bool mpi = false;
   bool resume = false;
   bool quiet = false;
 };
@@ -113,43 +117,66 @@ int runBuild(const BuildCommandOptions& o, const CLI::App& app) {
   p.entry.descriptor.gridSize = o.grid;
   p.entry.descriptor.sampling = *core::parseSampling(o.sampling);
 
-  if (o.resume) {
+  if (o.resume)
     // A resumed build continues with the file's own parameters; one given here that differs is an error.
-    auto store = io::Store::open(o.path);
-    if (!store) {
-      printError(store.error().message);
-      return kExitInputError;
-    }
-    const io::BuildParameters& have = store->parameters();
-    std::string conflict;
-    const auto check = [&](const char* flag, bool differs) {
-      if (app.count(flag) && differs && conflict.empty()) conflict = flag;
+    options.checkResume = [&](const io::Store& store) -> Status {
+      const io::BuildParameters& have = store.parameters();
+      std::string conflict;
+      const auto check = [&](const char* flag, bool differs) {
+        if (app.count(flag) && differs && conflict.empty()) conflict = flag;
+      };
+      check("--entries", have.entries != p.entries);
+      const auto evenIfNone = [](const io::BuildParameters& q) {
+        return q.weights.empty() ? std::vector<unsigned>(q.families.size(), 1) : q.weights;
+      };
+      check("--families", have.families != p.families || evenIfNone(have) != evenIfNone(p));
+      check("--modes", have.entry.modal.modes != p.entry.modal.modes);
+      check("--elements", have.entry.modal.order != p.entry.modal.order);
+      check("--grid", have.entry.descriptor.gridSize != p.entry.descriptor.gridSize);
+      check("--sampling", have.entry.descriptor.sampling != p.entry.descriptor.sampling);
+      check("--poisson", have.entry.modal.material.poissonRatio != p.entry.modal.material.poissonRatio);
+      const Result<io::Shard> stored = io::storedShard(store);
+      check("--shard", !stored || *stored != options.shard);
+      if (conflict.empty()) return Ok{};
+      return Error{ErrorCode::kInvalidArgument, o.path + ": was built with another " + conflict.substr(2) +
+                                                    " (its parameters: " + io::toJson(have) +
+                                                    "); a resumed build keeps them"};
     };
-    check("--entries", have.entries != p.entries);
-    const auto evenIfNone = [](const io::BuildParameters& q) {
-      return q.weights.empty() ? std::vector<unsigned>(q.families.size(), 1) : q.weights;
-    };
-    check("--families", have.families != p.families || evenIfNone(have) != evenIfNone(p));
-    check("--modes", have.entry.modal.modes != p.entry.modal.modes);
-    check("--elements", have.entry.modal.order != p.entry.modal.order);
-    check("--grid", have.entry.descriptor.gridSize != p.entry.descriptor.gridSize);
-    check("--sampling", have.entry.descriptor.sampling != p.entry.descriptor.sampling);
-    check("--poisson", have.entry.modal.material.poissonRatio != p.entry.modal.material.poissonRatio);
-    const Result<io::Shard> stored = io::storedShard(*store);
-    check("--shard", !stored || *stored != options.shard);
-    if (!conflict.empty()) {
-      printError(o.path + ": was built with another " + conflict.substr(2) +
-                 " (its parameters: " + io::toJson(have) + "); a resumed build keeps them");
-      return kExitUsage;
-    }
+
+    // With --mpi, rank 0 writes and reports; the other ranks compute and stay quiet.
+#ifdef SHAPEDB_HAVE_MPI
+  std::optional<io::MpiEnvironment> mpi;
+  if (o.mpi) mpi.emplace();
+  const bool reporting = !mpi || mpi->rank() == 0;
+#else
+  if (o.mpi) {
+    printError("--mpi: this shapedb was built without MPI (install libopenmpi-dev, then build it again)");
+    return kExitUsage;
   }
+  const bool reporting = true;
+#endif
   ProgressPrinter printer;
-  if (!o.quiet) options.progress = [&printer](const io::BuildProgress& progress) { printer(progress); };
+  if (!o.quiet && reporting)
+    options.progress = [&printer](const io::BuildProgress& progress) { printer(progress); };
+#ifdef SHAPEDB_HAVE_MPI
+  auto report = mpi ? io::buildDatabaseMpi(o.path, options) : io::buildDatabase(o.path, options);
+#else
   auto report = io::buildDatabase(o.path, options);
+#endif
+  if (!reporting) {
+    if (report || report.error().code == ErrorCode::kCancelled) return kExitOk;  // rank 0 tells
+    printError(report.error().message);
+    return kExitInputError;
+  }
   if (!report) {
     printError(report.error().message);
     return report.error().code == ErrorCode::kInvalidArgument ? kExitUsage : kExitInputError;
   }
+#ifdef SHAPEDB_HAVE_MPI
+  if (mpi && mpi->size() > 1)
+    std::printf("%s: on %d MPI ranks (rank 0 writing, %d computing)\n", o.path.c_str(), mpi->size(),
+                mpi->size() - 1);
+#endif
   const volume::StageTimes& t = report->stageSeconds;
   const double built = static_cast<double>(std::max<std::size_t>(1, report->built));
   std::printf("%s: %zu entries built, %zu failed, %zu already there, in %s (%.1f entries/s)\n",
@@ -401,6 +428,11 @@ Command addBuildCommand(CLI::App& parent) {
       "Build only part K of N of the catalog (K from 0 to N-1: the entries whose index is K mod N),\n"
       "into a file of its own, as a Slurm array task or a Kubernetes indexed job would; then\n"
       "'shapedb merge' joins the N files into the database one build would have made");
+  app->add_flag("--mpi", o->mpi,
+                "Spread the build over MPI ranks (mpirun -np N shapedb build DB --mpi ..., or srun): rank 0\n"
+                "writes DB and hands out entries one at a time, the others compute them (--threads each);\n"
+                "the file is the one a single build would write. A rank that dies ends the job; --resume\n"
+                "finishes it, on MPI or not");
   app->add_flag("--resume", o->resume, "Continue an interrupted build of DB with its own parameters");
   app->add_flag("--quiet", o->quiet, "No progress output");
   return {app, [o, app] { return runBuild(*o, *app); }};

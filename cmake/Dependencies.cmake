@@ -21,6 +21,15 @@ endif()
 set(SHAPEDB_HAVE_BULLET ${BULLET_FOUND})
 message(STATUS "shapedb: rigid-body scenario (Bullet): ${BULLET_FOUND}")
 
+# Optional: the database build on MPI (OpenMPI from Debian). Without it, everything else builds.
+option(SHAPEDB_WITH_MPI "Build the MPI database build (build --mpi) if MPI is found" ON)
+set(SHAPEDB_HAVE_MPI OFF)
+if(SHAPEDB_WITH_MPI)
+  find_package(MPI QUIET COMPONENTS CXX)
+  set(SHAPEDB_HAVE_MPI ${MPI_CXX_FOUND})
+endif()
+message(STATUS "shapedb: MPI build (build --mpi): ${SHAPEDB_HAVE_MPI}")
+
 # Optional: the Python module (pybind11 and NumPy from Debian, for Debian's own interpreter: another
 # python3 first on PATH would not have them). Without them, everything else builds.
 option(SHAPEDB_WITH_PYTHON "Build the Python module if pybind11 and NumPy are found" ON)

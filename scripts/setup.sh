@@ -15,6 +15,7 @@ packages=(
   nlohmann-json3-dev libsqlite3-dev libstb-dev zlib1g-dev sqlite3 libbullet-dev
   libsuitesparse-dev libblis4-serial
   python3-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
+  libopenmpi-dev openmpi-bin
 )
 # The sanitizer presets asan and fuzz build with Clang (fuzz links libFuzzer).
 case "$preset" in asan | fuzz) packages+=(clang-14 libclang-rt-14-dev) ;; esac

@@ -15,6 +15,9 @@
 #include <shapedb/io/build.h>
 #include <shapedb/volume/describe.h>
 
+#include "build_session.h"
+#include "codec.h"
+
 namespace shapedb::io {
 namespace {
 
@@ -45,32 +48,6 @@ Status validateParameters(const BuildParameters& p) {
   if (!core::validPoissonRatio(p.entry.modal.material.poissonRatio))
     return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in (-1, 0.5)"};
   return Ok{};
-}
-
-/// One catalog entry's outcome, carried from the parallel stage to the writer.
-struct Computed {
-  EntryRecord record;
-  std::optional<volume::EntryData> data;
-  std::optional<FailureRecord> failure;
-};
-
-Computed computeCatalogEntry(const volume::ShapeSpec& spec, core::EntryId id, const BuildParameters& p) {
-  Computed c;
-  c.record.id = id;
-  c.record.name = spec.name();
-  c.record.family = spec.family;
-  c.record.params = spec.params;
-  auto mesh = volume::makeFamilyShape(spec, p.resolution);
-  auto data = mesh ? volume::computeEntry(*mesh, p.entry) : Result<volume::EntryData>(mesh.error());
-  if (!data) {
-    c.failure = FailureRecord{c.record.name, data.error().message};
-    return c;
-  }
-  c.record.nodes = data->physics.tetMesh.nodeCount();
-  c.record.tets = data->physics.tetMesh.tetCount();
-  c.record.times = data->times;
-  c.data = std::move(data).value();
-  return c;
 }
 
 void addTimes(volume::StageTimes& sum, const volume::StageTimes& t) {
@@ -109,18 +86,151 @@ std::string toString(const Shard& shard) {
   return std::to_string(shard.index) + "/" + std::to_string(shard.count);
 }
 
-Result<Shard> storedShard(const Store& store) {
-  const std::optional<std::string> text = store.meta("shard");
-  if (!text) return Shard{};
-  Result<Shard> shard = parseShard(*text);
-  if (!shard)
-    return Error{ErrorCode::kParse, store.path().string() + ": unreadable shard: " + shard.error().message};
-  return shard;
+namespace detail {
+
+ComputedEntry computeCatalogEntry(const std::vector<volume::ShapeSpec>& catalog, std::size_t index,
+                                  const BuildParameters& p) {
+  const volume::ShapeSpec& spec = catalog[index];
+  ComputedEntry c;
+  c.record.id = static_cast<core::EntryId>(index);
+  c.record.name = spec.name();
+  c.record.family = spec.family;
+  c.record.params = spec.params;
+  auto mesh = volume::makeFamilyShape(spec, p.resolution);
+  auto data = mesh ? volume::computeEntry(*mesh, p.entry) : Result<volume::EntryData>(mesh.error());
+  if (!data) {
+    c.failure = FailureRecord{c.record.name, data.error().message};
+    return c;
+  }
+  c.record.nodes = data->physics.tetMesh.nodeCount();
+  c.record.tets = data->physics.tetMesh.tetCount();
+  c.record.times = data->times;
+  c.data = encodeEntry(*data);
+  return c;
 }
 
-Result<BuildReport> buildDatabase(const std::filesystem::path& path, const BuildOptions& options) {
-  const auto start = Clock::now();
-  std::optional<Store> opened;
+namespace {
+
+void putBytes(ByteWriter& w, const std::vector<std::uint8_t>& bytes) {
+  w.put<std::uint64_t>(bytes.size());
+  for (std::uint8_t b : bytes)
+    w.put(b);
+}
+
+bool getBytes(ByteReader& r, std::vector<std::uint8_t>& bytes) {
+  std::uint64_t size = 0;
+  if (!r.get(size) || !r.has(size, 1)) return false;
+  bytes.resize(size);
+  for (std::uint8_t& b : bytes)
+    r.get(b);
+  return r.ok();
+}
+
+void putText(ByteWriter& w, const std::string& text) {
+  putBytes(w, {text.begin(), text.end()});
+}
+
+bool getText(ByteReader& r, std::string& text) {
+  std::vector<std::uint8_t> bytes;
+  if (!getBytes(r, bytes)) return false;
+  text.assign(bytes.begin(), bytes.end());
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> toWire(const ComputedEntry& entry) {
+  ByteWriter w;
+  const EntryRecord& r = entry.record;
+  w.put<std::uint32_t>(r.id);
+  putText(w, r.name);
+  w.put<std::uint8_t>(entry.data ? 1 : 0);
+  if (!entry.data) {
+    putText(w, entry.failure ? entry.failure->message : std::string());
+    return std::move(w).take();
+  }
+  putText(w, volume::toString(r.family));
+  for (double x : {r.params.x(), r.params.y(), r.params.z(), r.times.normalize, r.times.tetrahedralize,
+                   r.times.describe, r.times.modes, r.times.collision})
+    w.put(x);
+  w.put<std::uint64_t>(r.nodes);
+  w.put<std::uint64_t>(r.tets);
+  for (const auto& blob : entry.data->descriptors)
+    putBytes(w, blob);
+  for (const auto& blob : entry.data->physics)
+    putBytes(w, blob);
+  return std::move(w).take();
+}
+
+Result<ComputedEntry> fromWire(const void* data, std::size_t size) {
+  ByteReader r(data, size);
+  ComputedEntry c;
+  std::uint8_t computed = 0;
+  const Error bad{ErrorCode::kParse, "a computed entry's bytes are truncated or garbled"};
+  if (!r.get(c.record.id) || !getText(r, c.record.name) || !r.get(computed)) return bad;
+  if (computed == 0) {
+    std::string message;
+    if (!getText(r, message) || !r.atEnd()) return bad;
+    c.failure = FailureRecord{c.record.name, message};
+    return c;
+  }
+  std::string family;
+  if (!getText(r, family)) return bad;
+  const auto parsed = volume::parseFamily(family);
+  if (!parsed) return bad;
+  c.record.family = *parsed;
+  std::array<double, 8> x{};
+  for (double& v : x)
+    r.get(v);
+  c.record.params = core::Vec3(x[0], x[1], x[2]);
+  c.record.times = {x[3], x[4], x[5], x[6], x[7]};
+  std::uint64_t nodes = 0, tets = 0;
+  r.get(nodes);
+  r.get(tets);
+  c.record.nodes = nodes;
+  c.record.tets = tets;
+  EncodedEntry e;
+  for (auto& blob : e.descriptors)
+    if (!getBytes(r, blob)) return bad;
+  for (auto& blob : e.physics)
+    if (!getBytes(r, blob)) return bad;
+  if (!r.atEnd()) return bad;
+  c.data = std::move(e);
+  return c;
+}
+
+struct BuildSession::State {
+  BuildOptions options;
+  std::optional<Store> store;
+  std::vector<volume::ShapeSpec> catalog;
+  std::vector<std::size_t> todo;
+  Clock::time_point start;
+  BuildReport report;
+  BuildProgress progress;
+  std::vector<EntryRecord> records;
+  std::vector<EncodedEntry> data;
+  std::vector<FailureRecord> failures;
+  std::optional<Error> writeError;
+
+  void flush() {
+    if (writeError || (records.empty() && failures.empty())) return;
+    if (Status st = store->write(records, data, failures); !st) writeError = st.error();
+    records.clear();
+    data.clear();
+    failures.clear();
+  }
+};
+
+BuildSession::BuildSession(std::unique_ptr<State> state) : mState(std::move(state)) {}
+BuildSession::BuildSession(BuildSession&&) noexcept = default;
+BuildSession& BuildSession::operator=(BuildSession&&) noexcept = default;
+BuildSession::~BuildSession() = default;
+
+Result<BuildSession> BuildSession::start(const std::filesystem::path& path, const BuildOptions& options) {
+  auto state = std::make_unique<State>();
+  state->options = options;
+  state->start = Clock::now();
+  std::optional<Store>& opened = state->store;
   if (options.resume) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec))
@@ -128,6 +238,8 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
     auto store = Store::open(path, /*writable=*/true);
     if (!store) return store.error();
     opened.emplace(std::move(store).value());
+    if (options.checkResume)
+      if (Status st = options.checkResume(*opened); !st) return st.error();
   } else {
     if (Status st = validateParameters(options.parameters); !st) return st.error();
     if (options.shard.count == 0 || options.shard.index >= options.shard.count)
@@ -148,7 +260,7 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
                                                   " of its catalog, not " + toString(options.shard)};
   if (Status st = store.setMeta("status", "building"); !st) return st.error();
 
-  // What is left to do: catalog entries neither stored nor recorded as failed.
+  // What is left to do: entries of this file's part neither stored nor recorded as failed.
   auto stored = store.entries();
   if (!stored) return stored.error();
   auto failed = store.failures();
@@ -158,37 +270,73 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
     done.insert(r.name);
   for (const FailureRecord& f : *failed)
     done.insert(f.name);
-  const std::vector<volume::ShapeSpec> catalog = volume::buildCatalog(p.entries, p.families, p.weights);
-  std::vector<std::size_t> todo;
+  state->catalog = volume::buildCatalog(p.entries, p.families, p.weights);
   std::size_t part = 0;
-  for (std::size_t i = 0; i < catalog.size(); ++i) {
+  for (std::size_t i = 0; i < state->catalog.size(); ++i) {
     if (!shard->holds(i)) continue;
     ++part;
-    if (!done.count(catalog[i].name())) todo.push_back(i);
+    if (!done.count(state->catalog[i].name())) state->todo.push_back(i);
   }
+  state->report.skipped = part - state->todo.size();
+  state->progress.total = state->todo.size();
+  state->progress.skipped = state->report.skipped;
+  return BuildSession(std::move(state));
+}
 
-  BuildReport report;
-  report.skipped = part - todo.size();
-  BuildProgress progress;
-  progress.total = todo.size();
-  progress.skipped = report.skipped;
+const BuildParameters& BuildSession::parameters() const {
+  return mState->store->parameters();
+}
+const std::vector<volume::ShapeSpec>& BuildSession::catalog() const {
+  return mState->catalog;
+}
+const std::vector<std::size_t>& BuildSession::todo() const {
+  return mState->todo;
+}
 
-  std::vector<EntryRecord> batchRecords;
-  std::vector<volume::EntryData> batchData;
-  std::vector<FailureRecord> batchFailures;
-  std::optional<Error> writeError;
-  std::atomic<bool> stop{false};
-  const auto flush = [&] {
-    if (writeError || (batchRecords.empty() && batchFailures.empty())) return;
-    if (Status st = store.write(batchRecords, batchData, batchFailures); !st) {
-      writeError = st.error();
-      stop = true;
-    }
-    batchRecords.clear();
-    batchData.clear();
-    batchFailures.clear();
-  };
+bool BuildSession::accept(ComputedEntry c) {
+  State& s = *mState;
+  s.progress.lastName = c.record.name;
+  if (c.failure) {
+    s.failures.push_back(std::move(*c.failure));
+    ++s.report.failed;
+    ++s.progress.failed;
+  } else {
+    addTimes(s.report.stageSeconds, c.record.times);
+    s.records.push_back(std::move(c.record));
+    s.data.push_back(std::move(*c.data));
+    ++s.report.built;
+  }
+  if (s.records.size() + s.failures.size() >= std::max<std::size_t>(1, s.options.batchSize)) s.flush();
+  ++s.progress.done;
+  s.progress.elapsedSeconds = secondsSince(s.start);
+  if (s.options.progress) s.options.progress(s.progress);
+  return !s.writeError;
+}
 
+Result<BuildReport> BuildSession::finish() {
+  State& s = *mState;
+  s.flush();
+  if (s.writeError) return *s.writeError;
+  Store& store = *s.store;
+  s.report.seconds = secondsSince(s.start);
+  const double previous = std::stod(store.meta("build_seconds").value_or("0"));
+  if (Status st = store.setMeta("build_seconds", std::to_string(previous + s.report.seconds)); !st)
+    return st.error();
+  if (Status st = store.setMeta("status", "complete"); !st) return st.error();
+  // Best effort: a reader holding the file open keeps it in WAL mode, which is as valid.
+  static_cast<void>(store.finish());
+  return s.report;
+}
+
+}  // namespace detail
+
+Result<BuildReport> buildDatabase(const std::filesystem::path& path, const BuildOptions& options) {
+  Result<detail::BuildSession> started = detail::BuildSession::start(path, options);
+  if (!started) return started.error();
+  detail::BuildSession& session = *started;
+  const std::vector<std::size_t>& todo = session.todo();
+  const BuildParameters& p = session.parameters();
+  bool stop = false;
   const int threads = options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
   tbb::task_arena arena(threads);
   arena.execute([&] {
@@ -203,41 +351,23 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
                                               }
                                               return todo[next++];
                                             }) &
-            tbb::make_filter<std::size_t, Computed>(tbb::filter_mode::parallel,
-                                                    [&](std::size_t i) {
-                                                      return computeCatalogEntry(
-                                                          catalog[i], static_cast<core::EntryId>(i), p);
-                                                    }) &
-            tbb::make_filter<Computed, void>(tbb::filter_mode::serial_in_order, [&](Computed c) {
-              progress.lastName = c.record.name;
-              if (c.failure) {
-                batchFailures.push_back(std::move(*c.failure));
-                ++report.failed;
-                ++progress.failed;
-              } else {
-                addTimes(report.stageSeconds, c.record.times);
-                batchRecords.push_back(std::move(c.record));
-                batchData.push_back(std::move(*c.data));
-                ++report.built;
-              }
-              if (batchRecords.size() + batchFailures.size() >= std::max<std::size_t>(1, options.batchSize))
-                flush();
-              ++progress.done;
-              progress.elapsedSeconds = secondsSince(start);
-              if (options.progress) options.progress(progress);
-            }));
+            tbb::make_filter<std::size_t, detail::ComputedEntry>(
+                tbb::filter_mode::parallel,
+                [&](std::size_t i) { return detail::computeCatalogEntry(session.catalog(), i, p); }) &
+            tbb::make_filter<detail::ComputedEntry, void>(
+                tbb::filter_mode::serial_in_order,
+                [&](detail::ComputedEntry c) { stop = !session.accept(std::move(c)) || stop; }));
   });
-  flush();
-  if (writeError) return *writeError;
+  return session.finish();
+}
 
-  report.seconds = secondsSince(start);
-  const double previous = std::stod(store.meta("build_seconds").value_or("0"));
-  if (Status st = store.setMeta("build_seconds", std::to_string(previous + report.seconds)); !st)
-    return st.error();
-  if (Status st = store.setMeta("status", "complete"); !st) return st.error();
-  // Best effort: a reader holding the file open keeps it in WAL mode, which is as valid.
-  static_cast<void>(store.finish());
-  return report;
+Result<Shard> storedShard(const Store& store) {
+  const std::optional<std::string> text = store.meta("shard");
+  if (!text) return Shard{};
+  Result<Shard> shard = parseShard(*text);
+  if (!shard)
+    return Error{ErrorCode::kParse, store.path().string() + ": unreadable shard: " + shard.error().message};
+  return shard;
 }
 
 namespace {
@@ -365,7 +495,7 @@ Result<MergeReport> mergeDatabases(const std::filesystem::path& out,
         if (progress) progress(done, total);
       }
     }
-    if (Status st = merged.write({}, {}, failures); !st) return st.error();
+    if (Status st = merged.write({}, std::span<const EncodedEntry>{}, failures); !st) return st.error();
     if (Status st = merged.setMeta("status", "complete"); !st) return st.error();
     static_cast<void>(merged.finish());
     report.entries = total;

@@ -355,7 +355,26 @@ std::optional<std::string> Store::meta(const std::string& key) const {
   return s.text(0);
 }
 
+EncodedEntry encodeEntry(const volume::EntryData& data) {
+  EncodedEntry e;
+  for (std::size_t k = 0; k < data.descriptors.size(); ++k)
+    e.descriptors[k] = encodeDescriptor(data.descriptors[k]);
+  const core::PhysicalData& p = data.physics;
+  e.physics = {encodeTetMesh(p.tetMesh), encodeMassProperties(p.massProperties), encodeModes(p.modes),
+               encodeCollision(p.collision), encodeSound(p.sound)};
+  return e;
+}
+
 Status Store::write(std::span<const EntryRecord> records, std::span<const volume::EntryData> data,
+                    std::span<const FailureRecord> failures) {
+  std::vector<EncodedEntry> encoded;
+  encoded.reserve(data.size());
+  for (const volume::EntryData& d : data)
+    encoded.push_back(encodeEntry(d));
+  return write(records, encoded, failures);
+}
+
+Status Store::write(std::span<const EntryRecord> records, std::span<const EncodedEntry> data,
                     std::span<const FailureRecord> failures) {
   Impl& s = *mImpl;
   if (records.size() != data.size()) return Error{ErrorCode::kInvalidArgument, "one record per entry"};
@@ -390,7 +409,7 @@ Status Store::write(std::span<const EntryRecord> records, std::span<const volume
     }
     entry.reset();
     for (std::size_t k = 0; k < data[i].descriptors.size(); ++k) {
-      const Bytes bytes = encodeDescriptor(data[i].descriptors[k]);
+      const Bytes& bytes = data[i].descriptors[k];
       descriptor.bind(1, static_cast<std::int64_t>(r.id));
       descriptor.bind(2, static_cast<std::int64_t>(k));
       descriptor.bind(3, bytes);
@@ -398,10 +417,7 @@ Status Store::write(std::span<const EntryRecord> records, std::span<const volume
       if (descriptor.step() != SQLITE_DONE) return fail("writing a descriptor of '" + r.name + "'");
       descriptor.reset();
     }
-    const core::PhysicalData& p = data[i].physics;
-    const std::array<Bytes, 5> parts = {encodeTetMesh(p.tetMesh), encodeMassProperties(p.massProperties),
-                                        encodeModes(p.modes), encodeCollision(p.collision),
-                                        encodeSound(p.sound)};
+    const std::array<Bytes, 5>& parts = data[i].physics;
     for (std::size_t k = 0; k < parts.size(); ++k) {
       physics.bind(1, static_cast<std::int64_t>(r.id));
       physics.bind(2, static_cast<std::int64_t>(k));

@@ -1,6 +1,8 @@
 // The database subcommands as a user runs them: the real executable, a real file, a real SIGKILL.
 
+#include <algorithm>
 #include <signal.h>
+#include <stdlib.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -196,6 +198,84 @@ TEST(BuildCli, ShardsBuiltSeparatelyAndMergedEqualASingleBuild) {
   EXPECT_NE(damaged.err.find("physics part 2 does not match its checksum"), std::string::npos) << damaged.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "refused.db"));
 }
+
+#ifdef SHAPEDB_MPIEXEC
+/// mpirun with as many ranks as asked on any machine (more ranks than cores), as root too (CI's).
+test::ProcessResult runMpi(int ranks, const std::vector<std::string>& args) {
+  setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  std::vector<std::string> argv = {"--oversubscribe", "-np", std::to_string(ranks), SHAPEDB_CLI};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return test::runProcess(SHAPEDB_MPIEXEC, argv);
+}
+
+/// The pid of the process whose command line holds `needle` and whose MPI rank is `rank`, or 0.
+pid_t findRank(const std::string& needle, int rank) {
+  std::error_code ec;  // processes come and go while /proc is read
+  for (auto it = std::filesystem::directory_iterator("/proc", ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+    const std::filesystem::directory_entry& e = *it;
+    const std::string pid = e.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::string cmdline = test::readFile(e.path() / "cmdline"),
+                environment = test::readFile(e.path() / "environ");
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    if (cmdline.find(needle) != std::string::npos && cmdline.find("--mpi") != std::string::npos &&
+        environment.find("OMPI_COMM_WORLD_RANK=" + std::to_string(rank) + '\0') != std::string::npos)
+      return static_cast<pid_t>(std::stol(pid));
+  }
+  return 0;
+}
+
+TEST(BuildCli, AnMpiBuildOnThreeRanksEqualsASingleBuildAndAKilledRankIsResumed) {
+  test::ScratchDir dir("build-mpi");
+  const std::vector<std::string> args = {"--entries", "24", "--families", "box,cone:2,shard",
+                                         "--modes",   "4",  "--threads",  "1",
+                                         "--batch",   "2",  "--quiet"};
+  const auto withArgs = [&](std::vector<std::string> head) {
+    head.insert(head.end(), args.begin(), args.end());
+    return head;
+  };
+  const test::ProcessResult single =
+      test::runProcess(SHAPEDB_CLI, withArgs({"build", (dir / "single.db").string()}));
+  ASSERT_EQ(single.exitCode, 0) << single.err;
+
+  // Rank 0 writes, ranks 1 and 2 compute: the same file, entry for entry and byte for byte.
+  const test::ProcessResult mpi = runMpi(3, withArgs({"build", (dir / "mpi.db").string(), "--mpi"}));
+  ASSERT_EQ(mpi.exitCode, 0) << mpi.err;
+  EXPECT_NE(mpi.out.find("on 3 MPI ranks (rank 0 writing, 2 computing)"), std::string::npos) << mpi.out;
+  EXPECT_NE(mpi.out.find("24 entries built"), std::string::npos) << mpi.out;
+  expectSameEntries(dir / "mpi.db", dir / "single.db");
+
+  // A computing rank killed for real once a few batches are in: the job ends, what was committed stays,
+  // and a resumed build (on MPI again) finishes the same file.
+  const std::filesystem::path killed = dir / "killed.db";
+  std::vector<std::string> argv = {"--oversubscribe", "-np",           "3",    SHAPEDB_CLI,
+                                   "build",           killed.string(), "--mpi"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  test::RunningProcess job(SHAPEDB_MPIEXEC, argv);
+  ASSERT_TRUE(job.started());
+  ASSERT_TRUE(test::waitUntil([&] { return committedEntries(killed) >= 4; }, 120.0));
+  const pid_t worker = findRank(killed.string(), 1);
+  ASSERT_GT(worker, 0) << "rank 1 not found";
+  ASSERT_EQ(::kill(worker, SIGKILL), 0);
+  ASSERT_TRUE(test::waitUntil([&] { return findRank(killed.string(), 0) == 0; }, 60.0))
+      << "the job went on without rank 1";
+  job.kill();  // reaps mpirun, whatever it did
+  const std::size_t atKill = committedEntries(killed);
+  std::printf("rank 1 killed with %zu of 24 entries committed\n", atKill);
+  ASSERT_LT(atKill, 24u) << "the build finished before its rank was killed";
+  const test::ProcessResult resumed = runMpi(3, {"build", killed.string(), "--mpi", "--resume", "--quiet"});
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find(std::to_string(atKill) + " already there"), std::string::npos) << resumed.out;
+  expectSameEntries(killed, dir / "single.db");
+
+  // Rank 0's refusal ends every rank, with its message.
+  const test::ProcessResult exists = runMpi(3, withArgs({"build", (dir / "mpi.db").string(), "--mpi"}));
+  EXPECT_NE(exists.exitCode, 0);
+  EXPECT_NE(exists.err.find("already exists"), std::string::npos) << exists.err;
+}
+#endif
 
 TEST(BuildCli, AFullDiskFailsClearlyKeepsWhatWasCommittedAndTheBuildResumes) {
   test::ScratchDir dir("build-full");

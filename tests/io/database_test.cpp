@@ -25,6 +25,7 @@
 #include <shapedb/volume/families.h>
 #include <shapedb/volume/modal.h>
 
+#include "build_session.h"
 #include "support/test_support.h"
 
 namespace shapedb::io {
@@ -702,6 +703,59 @@ TEST(Database, AddedMeshesAreFoundAndAnOpenOneIsRefusedWithNothingWritten) {
   auto duplicate = addToDatabase(path, std::span(bad).first(1));
   ASSERT_FALSE(duplicate.ok());
   EXPECT_NE(duplicate.error().message.find("already in the database"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace shapedb::io
+
+namespace shapedb::io {
+namespace {
+
+// A computed entry crosses from the rank that computed it to the one that writes as bytes: they must carry
+// the blobs unchanged (the file gets the single build's bytes), a failure with its reason, and nothing that
+// is not one of them.
+TEST(BuildWire, AComputedEntryCrossesUnchangedAndGarbageIsRefused) {
+  BuildParameters p;
+  p.entries = 4;
+  p.families = {volume::Family::kBox, volume::Family::kCone};
+  p.entry.modal.modes = 4;
+  const std::vector<volume::ShapeSpec> catalog = volume::buildCatalog(p.entries, p.families);
+  const detail::ComputedEntry computed = detail::computeCatalogEntry(catalog, 3, p);
+  ASSERT_TRUE(computed.data) << computed.failure->message;
+  const std::vector<std::uint8_t> wire = detail::toWire(computed);
+  const Result<detail::ComputedEntry> back = detail::fromWire(wire.data(), wire.size());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->record.id, 3u);
+  EXPECT_EQ(back->record.name, catalog[3].name());
+  EXPECT_EQ(back->record.family, catalog[3].family);
+  EXPECT_EQ(back->record.params, computed.record.params);
+  EXPECT_EQ(back->record.nodes, computed.record.nodes);
+  EXPECT_EQ(back->record.times.modes, computed.record.times.modes);
+  EXPECT_EQ(back->data->descriptors, computed.data->descriptors);
+  EXPECT_EQ(back->data->physics, computed.data->physics);
+  EXPECT_FALSE(back->failure);
+
+  detail::ComputedEntry failed;
+  failed.record.id = 7;
+  failed.record.name = "cone-00003";
+  failed.failure = FailureRecord{"cone-00003", "TetGen refused it"};
+  const std::vector<std::uint8_t> failedWire = detail::toWire(failed);
+  const Result<detail::ComputedEntry> failedBack = detail::fromWire(failedWire.data(), failedWire.size());
+  ASSERT_TRUE(failedBack.ok());
+  EXPECT_FALSE(failedBack->data);
+  EXPECT_EQ(failedBack->failure->message, "TetGen refused it");
+
+  // Every truncation, and bytes that run on, are refused; so is random noise.
+  for (std::size_t size : {std::size_t{0}, std::size_t{3}, wire.size() / 2, wire.size() - 1})
+    EXPECT_EQ(detail::fromWire(wire.data(), size).error().code, ErrorCode::kParse) << size;
+  std::vector<std::uint8_t> longer = wire;
+  longer.push_back(0);
+  EXPECT_FALSE(detail::fromWire(longer.data(), longer.size()).ok());
+  std::mt19937_64 rng(5);
+  std::vector<std::uint8_t> noise(4096);
+  for (std::uint8_t& b : noise)
+    b = static_cast<std::uint8_t>(rng());
+  EXPECT_FALSE(detail::fromWire(noise.data(), noise.size()).ok());
 }
 
 }  // namespace

@@ -51,6 +51,9 @@ struct BuildOptions {
   std::size_t batchSize = 16;  ///< entries per transaction: what a crash can cost
   /// Continue the build in an existing file: entries already in it (or recorded as failed) are skipped.
   bool resume = false;
+  /// With resume: called with the file once it is open, before anything is computed; an error ends the
+  /// build with it (a command line refusing parameters that differ from the file's, say).
+  std::function<Status(const Store& file)> checkResume;
   std::function<void(const BuildProgress&)> progress;  ///< called from one thread at a time
 };
 

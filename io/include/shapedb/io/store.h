@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -79,6 +80,14 @@ struct IntegrityReport {
   bool ok() const { return sqliteProblems.empty() && damaged.empty(); }
 };
 
+/// An entry's blobs as the file stores them: its three descriptors (by DescriptorKind), then the five parts
+/// of its physical data (tet mesh, mass properties, modes, collision, sound).
+struct EncodedEntry {
+  std::array<std::vector<std::uint8_t>, 3> descriptors;
+  std::array<std::vector<std::uint8_t>, 5> physics;
+};
+EncodedEntry encodeEntry(const volume::EntryData& data);
+
 /// The database file (SQLite, WAL mode): schema version and application id in the header, the build
 /// parameters and bookkeeping in `meta`, then `entries`, `descriptors` (one blob per entry and kind),
 /// `physics` (one blob per entry and part: tet mesh, mass properties, modes, collision, sound) and
@@ -109,6 +118,9 @@ class Store {
   /// Writes entries (and failures) in one transaction: all of them or none.
   /// Errors: kIo (disk full, read-only file, ...), kInvalidArgument (a duplicate id or name).
   Status write(std::span<const EntryRecord> records, std::span<const volume::EntryData> data,
+               std::span<const FailureRecord> failures = {});
+  /// The same, the entries already encoded (encodeEntry; computed elsewhere, say on another MPI rank).
+  Status write(std::span<const EntryRecord> records, std::span<const EncodedEntry> data,
                std::span<const FailureRecord> failures = {});
 
   /// Copies entries of `source` (another file) into this one as they are stored there, in one transaction:
