@@ -432,7 +432,8 @@ Command addBuildCommand(CLI::App& parent) {
                 "Spread the build over MPI ranks (mpirun -np N shapedb build DB --mpi ..., or srun): rank 0\n"
                 "writes DB and hands out entries one at a time, the others compute them (--threads each);\n"
                 "the file is the one a single build would write. A rank that dies ends the job; --resume\n"
-                "finishes it, on MPI or not");
+                "finishes it, on MPI or not. OpenMPI binds one or two ranks to a core each: give mpirun\n"
+                "--bind-to none for a rank to use all the cores of its node");
   app->add_flag("--resume", o->resume, "Continue an interrupted build of DB with its own parameters");
   app->add_flag("--quiet", o->quiet, "No progress output");
   return {app, [o, app] { return runBuild(*o, *app); }};
