@@ -11,7 +11,8 @@ Long work (building, querying, fracturing) releases the GIL.
 Functions
 ---------
 load_mesh(path, *, scale=1.0) -> (V, F)
-    OBJ, PLY, OFF or STL; a surface wound inward is flipped, an open one welded where that closes it.
+    OBJ, PLY, OFF or STL; a surface wound inward is flipped, an open one welded where that closes it, and
+    a UserWarning naming the file says so.
 mass_properties(V, F, *, density=1.0, approximate=False) -> dict
     Exact volume, mass, area, centre of mass and inertia (about the centre of mass) of the enclosed solid.
     ``approximate=True`` accepts an open surface (vertex point masses; ``is_approximate`` says so).
@@ -28,12 +29,14 @@ fracture(V, F, *, pieces=20, seed=1, resolution=0, max_triangles=3000) -> dict
 materials(), families()
     The material presets' and the catalog families' names.
 
-Database(path, *, cache_entries=64)
+Database(path, *, cache_entries=64, descriptors=None)
     ``query(V, F, *, k=1, descriptor="centroid-voxel", material="steel", correct=False, fidelity=True,
     approximate=False, adapt=True, correction_candidates=3) -> QueryResult``; ``query_many(meshes, ...)``
     answers a list of (V, F) at once over all cores, in input order, a failed mesh's :class:`Error` in its
     slot; ``info()``; ``len(db)``; ``close()``; usable in ``with``. ``material`` is a preset's name or a
-    dict with ``density``, ``youngs_modulus`` and ``poisson_ratio``.
+    dict with ``density``, ``youngs_modulus`` and ``poisson_ratio``. ``descriptors`` (say
+    ``["centroid-voxel"]``) builds only those kinds' indexes at open, a third of the reading each: a query
+    by another kind is then an error.
 
 QueryResult
     ``matches`` (best first: ``name``, ``family``, ``distance``, ``fidelity``,

@@ -254,9 +254,17 @@ py::dict linkDict(const std::shared_ptr<const io::QueryResult>& keep) {
 /// it alive even if the Python object is closed meanwhile.
 class PyDatabase {
  public:
-  PyDatabase(const std::string& path, std::size_t cacheEntries) : mPath(path) {
+  /// `descriptors`: the kinds whose indexes to build (None: all three); a query by another is an error.
+  PyDatabase(const std::string& path, std::size_t cacheEntries,
+             const std::optional<std::vector<std::string>>& descriptors)
+      : mPath(path) {
     io::Database::OpenOptions options;
     options.cacheEntries = cacheEntries;
+    if (descriptors) {
+      options.descriptors.clear();
+      for (const std::string& name : *descriptors)
+        options.descriptors.push_back(toKind(name));
+    }
     Result<io::Database> db = [&] {
       py::gil_scoped_release release;
       return io::Database::open(path, options);
@@ -348,7 +356,11 @@ py::tuple loadMesh(const std::string& path, double scale) {
     py::gil_scoped_release release;
     return io::loadMesh(path, options);
   }();
-  return meshTuple(std::move(unwrap(std::move(loaded)).mesh));
+  io::LoadedMesh mesh = unwrap(std::move(loaded));
+  // What was done to the file's surface (flipped, welded, faces dropped) as Python warnings, named.
+  for (const std::string& note : mesh.notes())
+    if (PyErr_WarnEx(PyExc_UserWarning, (path + ": " + note).c_str(), 1) != 0) throw py::error_already_set();
+  return meshTuple(std::move(mesh.mesh));
 }
 
 core::MassProperties massOf(const core::TriangleMesh& mesh, double density, bool approximate) {
@@ -540,7 +552,8 @@ PYBIND11_MODULE(_shapedb, m) {
       .def_property_readonly("times_us", [](const PyQueryResult& x) { return timesDict(x.result->times); });
 
   py::class_<PyDatabase>(m, "Database")
-      .def(py::init<const std::string&, std::size_t>(), "path"_a, py::kw_only(), "cache_entries"_a = 64)
+      .def(py::init<const std::string&, std::size_t, const std::optional<std::vector<std::string>>&>(),
+           "path"_a, py::kw_only(), "cache_entries"_a = 64, "descriptors"_a = py::none())
       .def(
           "query",
           [](const PyDatabase& db, const py::object& v, const py::object& f, int k,

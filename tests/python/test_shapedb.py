@@ -221,6 +221,32 @@ def test_info_and_a_resumed_build(tmp_path):
     assert e.value.code == "io"
 
 
+def test_a_database_opened_with_one_index_answers_by_it_alone(samples, database):
+    vertices, faces = load(samples / "doorstop.obj")
+    whole = shapedb.Database(str(database)).query(vertices, faces, k=3)
+    one = shapedb.Database(str(database), descriptors=["centroid-voxel"])
+    answer = one.query(vertices, faces, k=3)
+    assert [m.name for m in answer.matches] == [m.name for m in whole.matches]
+    np.testing.assert_array_equal(answer.physics["frequencies"], whole.physics["frequencies"])
+    with pytest.raises(shapedb.Error):
+        one.query(vertices, faces, descriptor="moment")
+    with pytest.raises(ValueError, match="descriptor"):
+        shapedb.Database(str(database), descriptors=["fourier"])
+
+
+def test_load_mesh_warns_of_what_it_did_to_the_file(tmp_path, samples):
+    vertices, faces = load(samples / "egg.obj")
+    inward = tmp_path / "inward.obj"
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices.tolist()]
+    lines += [f"f {a + 1} {c + 1} {b + 1}" for a, b, c in faces.tolist()]  # every face wound backwards
+    inward.write_text("\n".join(lines) + "\n")
+    with pytest.warns(UserWarning, match=r"inward.obj: the surface is wound inward .* flipped"):
+        flipped_vertices, flipped_faces = load(inward)
+    np.testing.assert_array_equal(flipped_vertices, vertices)
+    assert shapedb.mass_properties(flipped_vertices, flipped_faces)["volume"] == pytest.approx(
+        shapedb.mass_properties(vertices, faces)["volume"], rel=1e-12)
+
+
 # ---- fracture --------------------------------------------------------------------------------------------
 
 
