@@ -2,10 +2,10 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <numeric>
 #include <string>
 #include <tuple>
 
+#include <shapedb/core/disjoint_sets.h>
 #include <shapedb/core/physics.h>
 
 namespace shapedb::core {
@@ -140,22 +140,10 @@ std::size_t faceConnectedPieces(const TetMesh& mesh) {
     }
   }
   std::sort(faces.begin(), faces.end());
-  std::vector<std::uint32_t> parent(mesh.tets.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  const auto root = [&](std::uint32_t x) {
-    while (parent[x] != x)
-      x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  std::size_t pieces = mesh.tets.size();
-  for (std::size_t i = 0; i + 1 < faces.size(); ++i) {
-    if (faces[i].first != faces[i + 1].first) continue;
-    const std::uint32_t x = root(faces[i].second), y = root(faces[i + 1].second);
-    if (x == y) continue;
-    parent[x] = y;
-    --pieces;
-  }
-  return pieces;
+  DisjointSets pieces(mesh.tets.size());
+  for (std::size_t i = 0; i + 1 < faces.size(); ++i)
+    if (faces[i].first == faces[i + 1].first) pieces.unite(faces[i].second, faces[i + 1].second);
+  return pieces.sets();
 }
 
 TriangleMesh boundarySurface(const TetMesh& mesh) {

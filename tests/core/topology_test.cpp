@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <shapedb/core/disjoint_sets.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/topology.h>
 
@@ -161,6 +162,50 @@ TEST(Validate, RejectsEachDefectWithItsCode) {
   const MeshDefects d = findDefects(collinear);
   EXPECT_EQ(d.zeroAreaFaces, 1u);
   EXPECT_EQ(d.repeatedVertexFaces, 0u);
+}
+
+}  // namespace
+}  // namespace shapedb::core
+
+namespace shapedb::core {
+namespace {
+
+// Union-find against its oracle: the connected components of the same joins found by a breadth-first
+// search over them, on random graphs from sparse to nearly connected.
+TEST(DisjointSets, AgreeWithABreadthFirstSearchOnRandomJoins) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::uint32_t n = 1 + static_cast<std::uint32_t>(rng() % 300);
+    const std::size_t joins = rng() % (2 * n);
+    DisjointSets sets(n);
+    std::vector<std::vector<std::uint32_t>> neighbours(n);
+    for (std::size_t j = 0; j < joins; ++j) {
+      const auto a = static_cast<std::uint32_t>(rng() % n), b = static_cast<std::uint32_t>(rng() % n);
+      const bool wereApart = sets.find(a) != sets.find(b);
+      EXPECT_EQ(sets.unite(a, b), wereApart);
+      neighbours[a].push_back(b);
+      neighbours[b].push_back(a);
+    }
+    std::vector<int> component(n, -1);
+    int components = 0;
+    for (std::uint32_t start = 0; start < n; ++start) {
+      if (component[start] >= 0) continue;
+      std::vector<std::uint32_t> queue{start};
+      component[start] = components;
+      for (std::size_t q = 0; q < queue.size(); ++q)
+        for (std::uint32_t next : neighbours[queue[q]])
+          if (component[next] < 0) {
+            component[next] = components;
+            queue.push_back(next);
+          }
+      ++components;
+    }
+    ASSERT_EQ(sets.sets(), static_cast<std::size_t>(components)) << "trial " << trial;
+    for (std::uint32_t a = 0; a < n; ++a) {
+      const std::uint32_t b = static_cast<std::uint32_t>(rng() % n);
+      EXPECT_EQ(sets.find(a) == sets.find(b), component[a] == component[b]);
+    }
+  }
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <numeric>
 #include <string>
 #include <unordered_map>
 
@@ -13,6 +12,7 @@
 #include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
+#include <shapedb/core/disjoint_sets.h>
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
@@ -140,23 +140,17 @@ std::vector<double> holeRadii(const TriangleMesh& mesh) {
   for (const auto& t : mesh.triangles)
     for (int k = 0; k < 3; ++k)
       ++edgeUses[key(t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>((k + 1) % 3)])];
-  std::vector<std::uint32_t> parent(mesh.vertices.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  const auto find = [&](std::uint32_t v) {
-    while (parent[v] != v)
-      v = parent[v] = parent[parent[v]];
-    return v;
-  };
+  core::DisjointSets loopOf(mesh.vertices.size());
   std::vector<bool> onBoundary(mesh.vertices.size(), false);
   for (const auto& [edge, uses] : edgeUses) {
     if (uses != 1) continue;
     const auto a = static_cast<std::uint32_t>(edge >> 32), b = static_cast<std::uint32_t>(edge & 0xffffffffu);
     onBoundary[a] = onBoundary[b] = true;
-    parent[find(a)] = find(b);
+    loopOf.unite(a, b);
   }
   std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> loops;
   for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v)
-    if (onBoundary[v]) loops[find(v)].push_back(v);
+    if (onBoundary[v]) loops[loopOf.find(v)].push_back(v);
   std::vector<double> radii;
   for (const auto& [root, vertices] : loops) {
     Vec3 centre = Vec3::Zero();
