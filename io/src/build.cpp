@@ -336,7 +336,8 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
   detail::BuildSession& session = *started;
   const std::vector<std::size_t>& todo = session.todo();
   const BuildParameters& p = session.parameters();
-  bool stop = false;
+  // Set by the writer stage, read by the input stage: two serial stages that may run on two threads.
+  std::atomic<bool> stop{false};
   const int threads = options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
   tbb::task_arena arena(threads);
   arena.execute([&] {
@@ -354,9 +355,10 @@ Result<BuildReport> buildDatabase(const std::filesystem::path& path, const Build
             tbb::make_filter<std::size_t, detail::ComputedEntry>(
                 tbb::filter_mode::parallel,
                 [&](std::size_t i) { return detail::computeCatalogEntry(session.catalog(), i, p); }) &
-            tbb::make_filter<detail::ComputedEntry, void>(
-                tbb::filter_mode::serial_in_order,
-                [&](detail::ComputedEntry c) { stop = !session.accept(std::move(c)) || stop; }));
+            tbb::make_filter<detail::ComputedEntry, void>(tbb::filter_mode::serial_in_order,
+                                                          [&](detail::ComputedEntry c) {
+                                                            if (!session.accept(std::move(c))) stop = true;
+                                                          }));
   });
   return session.finish();
 }
