@@ -486,17 +486,20 @@ Result<MergeReport> mergeDatabases(const std::filesystem::path& out,
     for (const auto& [key, value] : meta)
       if (Status st = merged.setMeta(key, value); !st) return st.error();
     constexpr std::size_t kBatch = 64;
-    for (const ShardFile* part : byIndex) {
-      std::vector<core::EntryId> ids;
-      for (const EntryRecord& r : part->entries)
-        ids.push_back(r.id);
-      for (std::size_t at = 0; at < ids.size(); at += kBatch) {
-        const std::span<const core::EntryId> batch(ids.data() + at, std::min(kBatch, ids.size() - at));
-        if (Status st = merged.copyEntries(part->store, batch); !st) return st.error();
-        done += batch.size();
+    for (const ShardFile* part : byIndex)
+      for (std::size_t at = 0; at < part->entries.size(); at += kBatch) {
+        const std::span<const EntryRecord> records(part->entries.data() + at,
+                                                   std::min(kBatch, part->entries.size() - at));
+        std::vector<EncodedEntry> blobs;
+        for (const EntryRecord& r : records) {
+          Result<EncodedEntry> blob = part->store.encoded(r.id);
+          if (!blob) return blob.error();
+          blobs.push_back(std::move(blob).value());
+        }
+        if (Status st = merged.write(records, blobs); !st) return st.error();
+        done += records.size();
         if (progress) progress(done, total);
       }
-    }
     if (Status st = merged.write({}, std::span<const EncodedEntry>{}, failures); !st) return st.error();
     if (Status st = merged.setMeta("status", "complete"); !st) return st.error();
     static_cast<void>(merged.finish());

@@ -440,78 +440,41 @@ Status Store::write(std::span<const EntryRecord> records, std::span<const Encode
   return Ok{};
 }
 
-Status Store::copyEntries(const Store& source, std::span<const core::EntryId> ids) {
-  Impl& s = *mImpl;
-  const Impl& from = *source.mImpl;
-  Statement readEntry(
-      from.db, "SELECT id, name, family, params, source, nodes, tets, times FROM entries WHERE id = ?");
-  Statement readBlobs[2] = {
-      Statement(from.db, "SELECT kind, data, checksum FROM descriptors WHERE entry_id = ?"),
-      Statement(from.db, "SELECT part, data, checksum FROM physics WHERE entry_id = ?")};
-  if (!readEntry.ok() || !readBlobs[0].ok() || !readBlobs[1].ok())
-    return from.sqlError("preparing to read entries");
-  if (Status st = s.exec("BEGIN IMMEDIATE"); !st) return st.error();
-  const auto fail = [&](Error error) -> Status {
-    s.rollback();
-    return error;
+Result<EncodedEntry> Store::encoded(core::EntryId id) const {
+  const Impl& s = *mImpl;
+  const std::string where = s.path.string() + ": entry " + std::to_string(id);
+  EncodedEntry out;
+  const auto read = [&](const char* sql, auto& blobs, const char* what) -> Status {
+    Statement rows(s.db, sql);
+    if (!rows.ok()) return s.sqlError("reading entry " + std::to_string(id));
+    rows.bind(1, static_cast<std::int64_t>(id));
+    std::size_t found = 0;
+    int rc = 0;
+    while ((rc = rows.step()) == SQLITE_ROW) {
+      const std::int64_t k = rows.integer(0);
+      if (k < 0 || k >= static_cast<std::int64_t>(blobs.size())) continue;
+      const auto* blob = static_cast<const std::uint8_t*>(rows.blob(1));
+      if (checksum(blob, rows.blobSize(1)) != static_cast<std::uint32_t>(rows.integer(2)))
+        return Error{ErrorCode::kParse, where + ": " + what + " " + std::to_string(k) +
+                                            " does not match its checksum (the file is damaged)"};
+      blobs[static_cast<std::size_t>(k)].assign(blob, blob + rows.blobSize(1));
+      ++found;
+    }
+    if (rc != SQLITE_DONE) return s.sqlError("reading entry " + std::to_string(id));
+    if (found != blobs.size())
+      return Error{found == 0 ? ErrorCode::kInvalidArgument : ErrorCode::kParse,
+                   where + (found == 0 ? ": no such entry" : std::string(": a ") + what + " is missing")};
+    return Ok{};
   };
-  Statement entry(
-      s.db,
-      "INSERT INTO entries(id, name, family, params, source, nodes, tets, times) VALUES(?,?,?,?,?,?,?,?)");
-  Statement writeBlobs[2] = {
-      Statement(s.db, "INSERT INTO descriptors(entry_id, kind, data, checksum) VALUES(?,?,?,?)"),
-      Statement(s.db, "INSERT INTO physics(entry_id, part, data, checksum) VALUES(?,?,?,?)")};
-  if (!entry.ok() || !writeBlobs[0].ok() || !writeBlobs[1].ok())
-    return fail(s.sqlError("preparing the copy"));
-  const char* table[2] = {"descriptor", "physics part"};
-  for (const core::EntryId id : ids) {
-    readEntry.bind(1, static_cast<std::int64_t>(id));
-    if (readEntry.step() != SQLITE_ROW)
-      return fail(Error{ErrorCode::kInvalidArgument,
-                        from.path.string() + ": no entry " + std::to_string(id) + " to copy"});
-    const std::string name = readEntry.text(1);
-    entry.bind(1, readEntry.integer(0));
-    for (int c = 1; c <= 4; ++c)
-      entry.bind(c + 1, readEntry.text(c));
-    entry.bind(6, readEntry.integer(5));
-    entry.bind(7, readEntry.integer(6));
-    entry.bind(8, readEntry.text(7));
-    readEntry.reset();
-    if (const int rc = entry.step(); rc != SQLITE_DONE) {
-      if ((rc & 0xff) != SQLITE_CONSTRAINT) return fail(s.sqlError("copying entry '" + name + "'"));
-      return fail(Error{ErrorCode::kInvalidArgument, "entry '" + name + "' or id " + std::to_string(id) +
-                                                         " is already in " + s.path.string()});
-    }
-    entry.reset();
-    for (int t = 0; t < 2; ++t) {
-      Statement& read = readBlobs[t];
-      Statement& write = writeBlobs[t];
-      read.bind(1, static_cast<std::int64_t>(id));
-      int rc = 0;
-      while ((rc = read.step()) == SQLITE_ROW) {
-        const std::int64_t part = read.integer(0);
-        if (checksum(read.blob(1), read.blobSize(1)) != static_cast<std::uint32_t>(read.integer(2))) {
-          read.reset();
-          return fail(Error{ErrorCode::kParse, from.path.string() + ": entry '" + name + "': " + table[t] +
-                                                   " " + std::to_string(part) +
-                                                   " does not match its checksum (the file is damaged)"});
-        }
-        write.bind(1, static_cast<std::int64_t>(id));
-        write.bind(2, part);
-        sqlite3_bind_blob64(write.get(), 3, read.blob(1), read.blobSize(1), SQLITE_TRANSIENT);
-        write.bind(4, read.integer(2));
-        if (write.step() != SQLITE_DONE) {
-          read.reset();
-          return fail(s.sqlError("copying entry '" + name + "'"));
-        }
-        write.reset();
-      }
-      read.reset();
-      if (rc != SQLITE_DONE) return fail(from.sqlError("reading entry '" + name + "'"));
-    }
-  }
-  if (Status st = s.exec("COMMIT"); !st) return fail(st.error());
-  return Ok{};
+  if (Status st = read("SELECT kind, data, checksum FROM descriptors WHERE entry_id = ?", out.descriptors,
+                       "descriptor");
+      !st)
+    return st.error();
+  if (Status st =
+          read("SELECT part, data, checksum FROM physics WHERE entry_id = ?", out.physics, "physics part");
+      !st)
+    return st.error();
+  return out;
 }
 
 Result<std::vector<EntryRecord>> Store::entries() const {

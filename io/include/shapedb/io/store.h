@@ -123,12 +123,10 @@ class Store {
   Status write(std::span<const EntryRecord> records, std::span<const EncodedEntry> data,
                std::span<const FailureRecord> failures = {});
 
-  /// Copies entries of `source` (another file) into this one as they are stored there, in one transaction:
-  /// their records (build times included) and blobs, each blob's checksum verified on the way. How shards
-  /// are merged (io/build.h): the result holds the very bytes a single build would have written.
-  /// Errors: kInvalidArgument (an id not in `source`; an id or name already here), kParse (a corrupted
-  /// blob in `source`, named), kIo.
-  Status copyEntries(const Store& source, std::span<const core::EntryId> ids);
+  /// One entry's blobs as stored, every checksum verified: what a merge copies into another file with
+  /// write (io/build.h), the very bytes a single build would have written. Errors: kInvalidArgument (no
+  /// such entry), kParse (a blob damaged or missing, named), kIo.
+  Result<EncodedEntry> encoded(core::EntryId id) const;
 
   Result<std::vector<EntryRecord>> entries() const;
   Result<std::vector<FailureRecord>> failures() const;
