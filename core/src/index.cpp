@@ -54,11 +54,11 @@ inline int squaredCodeDistance(std::uint16_t a, std::uint16_t b) {
 }
 
 /// Filled-cell counts of a voxel descriptor per part of four partitions of its grid: the slabs along
-/// x, y and z (16 bins each) and a 4³ block grid. Any partition bounds eq. (5) and (6) from below.
-struct CountProfile {
-  std::array<std::uint8_t, 48> slabs{};
-  std::array<std::uint8_t, 64> blocks{};
-};
+/// x, y and z (16 bins each, bytes 0-47) and a 4³ block grid (bytes 48-111). Any partition bounds
+/// eq. (5) and (6) from below.
+constexpr std::size_t kSlabBytes = 3 * kProfileBins;
+constexpr std::size_t kProfileBytes = kSlabBytes + kBlocksPerAxis * kBlocksPerAxis * kBlocksPerAxis;
+using CountProfile = std::array<std::uint8_t, kProfileBytes>;
 
 // Filled cells per part of four partitions of the grid: slabs along x, y and z (16 bins each; with
 // N > 16 adjacent slabs share a bin) and a coarse 4³ block grid. Counts saturate at 255, which keeps
@@ -79,11 +79,11 @@ CountProfile countProfile(const std::uint64_t* bits, int n) {
           bin(ijk[0], kBlocksPerAxis) +
           kBlocksPerAxis * (bin(ijk[1], kBlocksPerAxis) + kBlocksPerAxis * bin(ijk[2], kBlocksPerAxis)))];
     }
-  CountProfile out;
-  for (std::size_t i = 0; i < out.slabs.size(); ++i)
-    out.slabs[i] = static_cast<std::uint8_t>(std::min(slabs[i], 255));
-  for (std::size_t i = 0; i < out.blocks.size(); ++i)
-    out.blocks[i] = static_cast<std::uint8_t>(std::min(blocks[i], 255));
+  CountProfile out{};
+  for (std::size_t i = 0; i < slabs.size(); ++i)
+    out[i] = static_cast<std::uint8_t>(std::min(slabs[i], 255));
+  for (std::size_t i = 0; i < blocks.size(); ++i)
+    out[kSlabBytes + i] = static_cast<std::uint8_t>(std::min(blocks[i], 255));
   return out;
 }
 
@@ -113,6 +113,30 @@ inline double jaccard(std::uint32_t exclusive, std::uint32_t total) {
   return total + exclusive == 0 ? 0.0 : 2.0 * exclusive / (static_cast<double>(total) + exclusive);
 }
 
+// Σ max(0, least[i] − q[i], q[i] − most[i]) over N bytes: the least Σ |q[i] − e[i]| over any e with
+// least ≤ e ≤ most, bytewise.
+template <std::size_t N>
+std::uint32_t distanceToRangeSum(const std::uint8_t* q, const std::uint8_t* least, const std::uint8_t* most) {
+  static_assert(N % 16 == 0);
+#if defined(__SSE2__)
+  __m128i sum = _mm_setzero_si128();
+  for (std::size_t i = 0; i < N; i += 16) {
+    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(q + i));
+    const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(least + i));
+    const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(most + i));
+    // At most one of the two saturated differences is non-zero, so their sum fits a byte.
+    const __m128i outside = _mm_add_epi8(_mm_subs_epu8(x, hi), _mm_subs_epu8(lo, x));
+    sum = _mm_add_epi64(sum, _mm_sad_epu8(outside, _mm_setzero_si128()));
+  }
+  return static_cast<std::uint32_t>(_mm_cvtsi128_si32(sum) + _mm_extract_epi16(sum, 4));
+#else
+  std::uint32_t sum = 0;
+  for (std::size_t i = 0; i < N; ++i)
+    sum += static_cast<std::uint32_t>(std::max({0, int{least[i]} - int{q[i]}, int{q[i]} - int{most[i]}}));
+  return sum;
+#endif
+}
+
 inline std::uint32_t absoluteDifference(std::uint32_t a, std::uint32_t b) {
   return a > b ? a - b : b - a;
 }
@@ -127,6 +151,12 @@ void packOccupancy(const std::vector<std::uint32_t>& cells, std::uint64_t* words
 // degenerate one finite).
 Vec3 logMoments(const Vec3& moments) {
   return moments.cwiseMax(std::numeric_limits<double>::min()).array().log().matrix();
+}
+
+// Bytes a vector holds, capacity included.
+template <class T>
+std::size_t bytesOf(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
 }
 
 inline bool isGrid(DescriptorKind kind) {
@@ -166,6 +196,15 @@ const char* toString(SearchMethod method) {
 struct Index::Impl {
   struct Query;
   class TopK;
+  /// A node of a bucket's cluster tree: consecutive slots of the bucket, and the range of what their
+  /// bounds compare. A leaf holds up to kLeafSlots slots; an inner node, its two children's.
+  struct Cluster {
+    std::uint32_t begin = 0, end = 0;    ///< slots
+    std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
+    std::array<float, 3> lowest{};       ///< least ln moment per axis, rounded down
+    std::array<float, 3> highest{};      ///< greatest, rounded up
+    CountProfile least, most;            ///< per part of every partition
+  };
 
   explicit Impl(const DescriptorOptions& options);
   std::size_t size() const { return mIds.size(); }
@@ -173,10 +212,16 @@ struct Index::Impl {
   Result<std::vector<Match>> search(std::span<const Descriptor> candidates, const SearchOptions& options,
                                     SearchStats* stats) const;
 
+  const std::uint8_t* profile(std::size_t slot) const { return &mProfiles[slot * kProfileBytes]; }
+  const std::uint16_t* centroids(std::size_t slot) const {
+    const std::uint64_t at = mCentroidAt[slot];
+    return mCentroidChunks[at >> 32].data() + (at & 0xffffffffu);
+  }
   Query prepare(const Descriptor& descriptor, int candidate, double momentWeight) const;
   double momentTerm(const Query& q, std::size_t slot) const;
   double gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const;
   double gridBound(const Query& q, std::size_t slot, double moments) const;
+  double clusterBound(const Query& q, std::int32_t cluster, double threshold) const;
   double countBound(const Query& q, std::uint32_t count) const;
   double mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const;
   void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
@@ -186,22 +231,27 @@ struct Index::Impl {
   DescriptorOptions mOptions;
   std::uint32_t mWords = 0;   ///< 64-bit words of occupancy per entry
   std::vector<EntryId> mIds;  ///< per slot
+  /// Per slot: the moments in k-d tree order (moment kind), or their logarithms (voxel kinds, for the
+  /// moment term).
+  std::vector<Vec3> mMoments;
   // Voxel kinds, per slot.
   std::vector<std::uint32_t> mCounts;
   std::vector<std::uint64_t> mBits;
-  std::vector<CountProfile> mProfiles;
-  std::vector<std::uint64_t> mCentroidBegin;  ///< size() + 1 offsets into mCentroids
-  std::vector<std::uint16_t> mCentroids;
+  std::vector<std::uint8_t> mProfiles;     ///< a CountProfile per slot
+  std::vector<std::uint64_t> mCentroidAt;  ///< chunk << 32 | offset of the slot's first centroid
+  std::vector<std::vector<std::uint16_t>> mCentroidChunks;
   std::vector<std::uint32_t> mBucketBegin;  ///< first slot of each filled-cell count, N³ + 2 entries
-  std::vector<Vec3> mLogMoments;            ///< ln of the canonical moments, for the moment term
-  // Moment kind: points in k-d tree order.
+  std::vector<std::int32_t> mBucketRoot;    ///< root cluster of each filled-cell count, -1 if none
+  std::vector<Cluster> mClusters;
+  /// Per cluster, the cells filled in all of its entries (mWords words), then those filled in any.
+  std::vector<std::uint64_t> mClusterBits;
+  // Moment kind: the tree over mMoments.
   struct Node {
     std::uint32_t begin, end;
     std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
     int axis = 0;
     double split = 0.0;
   };
-  std::vector<Vec3> mMoments;
   std::vector<Node> mNodes;
 };
 
@@ -263,16 +313,19 @@ class Index::Impl::TopK {
 Index::Impl::Impl(const DescriptorOptions& options) : mOptions(options) {
   const int n = options.gridSize;
   mWords = isGrid(options.kind) ? static_cast<std::uint32_t>((n * n * n + 63) / 64) : 0;
-  mCentroidBegin.assign(1, 0);
-  if (isGrid(options.kind)) mBucketBegin.assign(static_cast<std::size_t>(n * n * n + 2), 0);
+  if (isGrid(options.kind)) {
+    mBucketBegin.assign(static_cast<std::size_t>(n * n * n + 2), 0);
+    mBucketRoot.assign(mBucketBegin.size() - 1, -1);
+  }
 }
 
 std::size_t Index::Impl::memoryBytes() const {
-  return mIds.size() * sizeof(EntryId) + mCounts.size() * sizeof(std::uint32_t) +
-         mBits.size() * sizeof(std::uint64_t) + mProfiles.size() * sizeof(CountProfile) +
-         mCentroidBegin.size() * sizeof(std::uint64_t) + mCentroids.size() * sizeof(std::uint16_t) +
-         mBucketBegin.size() * sizeof(std::uint32_t) + (mMoments.size() + mLogMoments.size()) * sizeof(Vec3) +
-         mNodes.size() * sizeof(Node);
+  std::size_t chunks = bytesOf(mCentroidChunks);
+  for (const auto& chunk : mCentroidChunks)
+    chunks += bytesOf(chunk);
+  return bytesOf(mIds) + bytesOf(mMoments) + bytesOf(mCounts) + bytesOf(mBits) + bytesOf(mProfiles) +
+         bytesOf(mCentroidAt) + chunks + bytesOf(mBucketBegin) + bytesOf(mBucketRoot) + bytesOf(mClusters) +
+         bytesOf(mClusterBits) + bytesOf(mNodes);
 }
 
 Index::Impl::Query Index::Impl::prepare(const Descriptor& d, int candidate, double momentWeight) const {
@@ -294,10 +347,13 @@ Index::Impl::Query Index::Impl::prepare(const Descriptor& d, int candidate, doub
   return q;
 }
 
-// w · Σ |ln mᵢ − ln m'ᵢ| between the query and the entry in `slot`.
+// w · Σ |ln mᵢ − ln m'ᵢ| between the query and the entry in `slot`, summed in axis order as clusterBound
+// sums its bound (so that the bound, term by term no larger, is no larger in floating point either).
 double Index::Impl::momentTerm(const Query& q, std::size_t slot) const {
   if (q.momentWeight == 0.0) return 0.0;
-  return q.momentWeight * (q.logMoments - mLogMoments[slot]).cwiseAbs().sum();
+  const Vec3& m = mMoments[slot];
+  return q.momentWeight * ((std::abs(q.logMoments[0] - m[0]) + std::abs(q.logMoments[1] - m[1])) +
+                           std::abs(q.logMoments[2] - m[2]));
 }
 
 // Eq. (5) or (6) between the query and the entry in `slot`, on quantized centroids, plus `moments` (its
@@ -320,7 +376,7 @@ double Index::Impl::gridDistance(const Query& q, std::size_t slot, double thresh
     return (static_cast<double>(exclusive) + static_cast<double>(terms) * kTermUnit) / total + moments;
   };
   const auto& table = centroidDistanceTable();
-  const std::uint16_t* centroids = &mCentroids[mCentroidBegin[slot]];
+  const std::uint16_t* entryCentroids = centroids(slot);
   std::uint64_t terms = 0;
   std::uint32_t rank = 0;
   for (std::uint32_t w = 0; w < mWords; ++w) {
@@ -330,7 +386,7 @@ double Index::Impl::gridDistance(const Query& q, std::size_t slot, double thresh
       const int bit = std::countr_zero(both);
       const auto index =
           rank + static_cast<std::uint32_t>(std::popcount(entryWord & ((std::uint64_t{1} << bit) - 1)));
-      terms += table[static_cast<std::size_t>(squaredCodeDistance(centroids[index], queryCodes[bit]))];
+      terms += table[static_cast<std::size_t>(squaredCodeDistance(entryCentroids[index], queryCodes[bit]))];
     }
     rank += static_cast<std::uint32_t>(std::popcount(entryWord));
     if ((w & 3) == 3 && value(terms) > threshold) return value(terms);
@@ -342,15 +398,56 @@ double Index::Impl::gridDistance(const Query& q, std::size_t slot, double thresh
 // least Σ |count_a − count_b| over the parts of any partition of the grid (slabs, blocks); plus the
 // entry's moment term `moments`, the same value gridDistance adds.
 double Index::Impl::gridBound(const Query& q, std::size_t slot, double moments) const {
-  const CountProfile& p = mProfiles[slot];
-  const std::uint8_t* a = p.slabs.data();
-  const std::uint8_t* b = q.profile.slabs.data();
-  std::uint32_t best = absoluteDifferenceSum<64>(p.blocks.data(), q.profile.blocks.data());
+  const std::uint8_t* a = profile(slot);
+  const std::uint8_t* b = q.profile.data();
+  std::uint32_t best = absoluteDifferenceSum<kProfileBytes - kSlabBytes>(a + kSlabBytes, b + kSlabBytes);
   for (int axis = 0; axis < 3; ++axis)
     best =
         std::max(best, absoluteDifferenceSum<kProfileBins>(a + axis * kProfileBins, b + axis * kProfileBins));
   best = std::max(best, absoluteDifference(mCounts[slot], q.count));
   return mismatchDistance(best, mCounts[slot] + q.count) + moments;
+}
+
+// A lower bound of gridDistance for every slot of a cluster (its slots share one filled-cell count): a
+// cell filled in the query and in none of the entries, or in all of them and not in the query, is
+// filled in one grid only; each part's count differs from the query's at least by its distance to the
+// cluster's range of that part; each ln moment differs at least by its distance to the cluster's
+// range. Summed in the same order as gridDistance and momentTerm sum theirs, term by term no larger,
+// so no larger in floating point either. Returns as soon as the terms so far exceed `threshold`.
+double Index::Impl::clusterBound(const Query& q, std::int32_t index, double threshold) const {
+  const Cluster& cluster = mClusters[static_cast<std::size_t>(index)];
+  const std::uint32_t count = mCounts[cluster.begin];
+  double moments = 0.0;
+  if (q.momentWeight != 0.0) {
+    const auto outside = [&](int axis) {
+      const double x = q.logMoments[axis];
+      const auto a = static_cast<std::size_t>(axis);
+      return std::max(
+          {0.0, static_cast<double>(cluster.lowest[a]) - x, x - static_cast<double>(cluster.highest[a])});
+    };
+    moments = q.momentWeight * ((outside(0) + outside(1)) + outside(2));
+  }
+  // The cheapest terms first: the moments and the count may already put the cluster past the threshold.
+  std::uint32_t best = absoluteDifference(count, q.count);
+  if (const double bound = mismatchDistance(best, count + q.count) + moments; bound > threshold) return bound;
+  const std::uint64_t* all = &mClusterBits[static_cast<std::size_t>(index) * 2 * mWords];
+  const std::uint64_t* any = all + mWords;
+  std::uint32_t surely = 0;
+  for (std::uint32_t w = 0; w < mWords; ++w)
+    surely +=
+        static_cast<std::uint32_t>(std::popcount(q.bits[w] & ~any[w]) + std::popcount(all[w] & ~q.bits[w]));
+  best = std::max(best, surely);
+  if (const double bound = mismatchDistance(best, count + q.count) + moments; bound > threshold) return bound;
+  const std::uint8_t* b = q.profile.data();
+  const std::uint8_t* least = cluster.least.data();
+  const std::uint8_t* most = cluster.most.data();
+  best = std::max(best, distanceToRangeSum<kProfileBytes - kSlabBytes>(b + kSlabBytes, least + kSlabBytes,
+                                                                       most + kSlabBytes));
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::size_t at = static_cast<std::size_t>(axis) * kProfileBins;
+    best = std::max(best, distanceToRangeSum<kProfileBins>(b + at, least + at, most + at));
+  }
+  return mismatchDistance(best, count + q.count) + moments;
 }
 
 // The bound for every entry with `count` filled cells: |count − n_q| cells are filled in one only
@@ -369,26 +466,54 @@ double Index::Impl::mismatchDistance(std::uint32_t exclusive, std::uint32_t tota
 
 // Buckets of equal filled-cell count, visited outward from the query's count in order of their bound;
 // a side stops when its bound exceeds the k-th best distance (the bounds grow monotonically outward).
-// With `parallel`, once the nearest buckets have set a threshold, the buckets still within it are
-// scanned by TBB tasks that share the least of their k-th bests: each is an upper bound of the final
-// k-th best, so pruning against it stays exact, and merging the lists gives the same answer as one
-// thread.
+// Within a bucket, its cluster tree is walked depth first, the nearer child (by bound) first, and a
+// cluster whose bound exceeds the k-th best is skipped whole; the entries of the leaves reached are
+// bounded one by one. With `parallel`, once the nearest buckets have set a threshold, the buckets still
+// within it are scanned by TBB tasks that share the least of their k-th bests: each is an upper bound of
+// the final k-th best, so pruning against it stays exact, and merging the lists gives the same answer as
+// one thread.
 void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const {
   const auto maxCount = static_cast<std::int64_t>(mBucketBegin.size()) - 2;
   std::int64_t up = std::min<std::int64_t>(q.count, maxCount + 1), down = up - 1;
-  const auto bucket = [&](std::int64_t count) {
-    const auto c = static_cast<std::size_t>(count);
-    return std::pair<std::size_t, std::size_t>(mBucketBegin[c], mBucketBegin[c + 1]);
-  };
-  const auto scan = [&](std::size_t begin, std::size_t end, TopK& local, SearchStats& st, double shared) {
-    for (std::size_t slot = begin; slot < end; ++slot) {
-      ++st.boundEvaluations;
-      const double threshold = std::min(shared, local.threshold());
-      const double moments = momentTerm(q, slot);
-      if (gridBound(q, slot, moments) > threshold) continue;
-      ++st.distanceEvaluations;
-      local.push(gridDistance(q, slot, threshold, moments), mIds[slot], q.candidate, moments);
+  const auto scan = [&](std::int64_t count, TopK& local, SearchStats& st, double shared) {
+    const std::int32_t root = mBucketRoot[static_cast<std::size_t>(count)];
+    if (root < 0) return;
+    struct Pending {
+      std::int32_t cluster;
+      double bound;
+    };
+    std::array<Pending, 128> stack;  // a tree of < 2³² slots is < 32 deep; one sibling waits per level
+    std::size_t depth = 0;
+    stack[depth++] = {root, clusterBound(q, root, std::min(shared, local.threshold()))};
+    ++st.groupBoundEvaluations;
+    while (depth > 0) {
+      const Pending pending = stack[--depth];
+      if (pending.bound > std::min(shared, local.threshold())) continue;
+      const Cluster& cluster = mClusters[static_cast<std::size_t>(pending.cluster)];
+      if (cluster.left >= 0) {
+        const double threshold = std::min(shared, local.threshold());
+        const Pending left{cluster.left, clusterBound(q, cluster.left, threshold)};
+        const Pending right{cluster.right, clusterBound(q, cluster.right, threshold)};
+        st.groupBoundEvaluations += 2;
+        // The farther below the nearer, so that the nearer is taken first.
+        const bool leftFirst = left.bound <= right.bound;
+        stack[depth++] = leftFirst ? right : left;
+        stack[depth++] = leftFirst ? left : right;
+        continue;
+      }
+      for (std::size_t slot = cluster.begin; slot < cluster.end; ++slot) {
+        ++st.boundEvaluations;
+        const double threshold = std::min(shared, local.threshold());
+        const double moments = momentTerm(q, slot);
+        if (gridBound(q, slot, moments) > threshold) continue;
+        ++st.distanceEvaluations;
+        local.push(gridDistance(q, slot, threshold, moments), mIds[slot], q.candidate, moments);
+      }
     }
+  };
+  const auto slotsOf = [&](std::int64_t count) {
+    const auto c = static_cast<std::size_t>(count);
+    return std::size_t{mBucketBegin[c + 1] - mBucketBegin[c]};
   };
   // The next bucket in bound order, or -1 when no bucket left can hold a match.
   const auto next = [&](double threshold) -> std::int64_t {
@@ -401,18 +526,17 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
   constexpr std::size_t kSequentialSlots = 8192;
   std::size_t scanned = 0;
   for (std::int64_t c = next(top.threshold()); c >= 0; c = next(top.threshold())) {
-    const auto [begin, end] = bucket(c);
-    scan(begin, end, top, stats, kInfinity);
-    scanned += end - begin;
+    scan(c, top, stats, kInfinity);
+    scanned += slotsOf(c);
     if (parallel && scanned >= kSequentialSlots) break;
   }
   if (!parallel || scanned < kSequentialSlots) return;
 
   // The buckets left within the threshold, scanned in parallel.
-  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  std::vector<std::int64_t> buckets;
   for (std::int64_t c = next(top.threshold()); c >= 0; c = next(top.threshold()))
-    if (bucket(c).second > bucket(c).first) ranges.push_back(bucket(c));
-  if (ranges.empty()) return;
+    if (slotsOf(c) > 0) buckets.push_back(c);
+  if (buckets.empty()) return;
   std::atomic<double> shared{top.threshold()};
   struct Part {
     TopK top;
@@ -420,11 +544,10 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
   };
   const std::size_t k = top.capacity();
   const Part found = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, ranges.size(), 1), Part{TopK(k), {}},
+      tbb::blocked_range<std::size_t>(0, buckets.size(), 1), Part{TopK(k), {}},
       [&](const tbb::blocked_range<std::size_t>& r, Part part) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          scan(ranges[i].first, ranges[i].second, part.top, part.stats,
-               shared.load(std::memory_order_relaxed));
+          scan(buckets[i], part.top, part.stats, shared.load(std::memory_order_relaxed));
           // Publish this task's k-th best if it lowers the shared threshold.
           double seen = shared.load(std::memory_order_relaxed);
           const double mine = part.top.threshold();
@@ -436,11 +559,13 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
       [](Part a, const Part& b) {
         a.top.merge(b.top);
         a.stats.boundEvaluations += b.stats.boundEvaluations;
+        a.stats.groupBoundEvaluations += b.stats.groupBoundEvaluations;
         a.stats.distanceEvaluations += b.stats.distanceEvaluations;
         return a;
       });
   top.merge(found.top);
   stats.boundEvaluations += found.stats.boundEvaluations;
+  stats.groupBoundEvaluations += found.stats.groupBoundEvaluations;
   stats.distanceEvaluations += found.stats.distanceEvaluations;
 }
 
@@ -564,31 +689,131 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
   return mImpl->search(candidates, options, stats);
 }
 
+namespace {
+
+constexpr std::uint32_t kLeafSlots = 16;
+// Centroids per chunk (2 MiB): an entry's never straddle two, and a chunk, once full, never moves.
+constexpr std::size_t kCentroidChunk = std::size_t{1} << 20;
+
+// Reorders `values`, records of `width` elements, in place so that the record at `order[slot]` comes to
+// `slot` (`order` a permutation), one cycle at a time: one record of extra memory.
+template <class T>
+void permute(std::vector<T>& values, std::size_t width, const std::vector<std::uint32_t>& order) {
+  std::vector<bool> done(order.size(), false);
+  std::vector<T> held(width);
+  for (std::size_t start = 0; start < order.size(); ++start) {
+    if (done[start]) continue;
+    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(start * width), width, held.begin());
+    for (std::size_t to = start;;) {
+      done[to] = true;
+      const std::size_t from = order[to];
+      T* destination = values.data() + to * width;
+      if (from == start) {
+        std::copy_n(held.begin(), width, destination);
+        break;
+      }
+      std::copy_n(values.data() + from * width, width, destination);
+      to = from;
+    }
+  }
+}
+
+// Orders order[begin, end) (entries of one bucket, slots once reordered) into a cluster tree, appended
+// to `clusters`: a k-d split along the widest axis of the ln moments, at a multiple of kLeafSlots (so
+// that leaves are full), the median by (value, id) for determinism. Returns the root's index; children
+// come after their parent. Their ranges are filled in later, from the reordered slots.
+template <class Cluster>
+std::int32_t arrangeClusters(std::vector<std::uint32_t>& order, std::uint32_t begin, std::uint32_t end,
+                             const std::vector<Vec3>& logMoments, const std::vector<EntryId>& ids,
+                             std::vector<Cluster>& clusters) {
+  const auto self = static_cast<std::int32_t>(clusters.size());
+  clusters.emplace_back();
+  clusters.back().begin = begin;
+  clusters.back().end = end;
+  if (end - begin <= kLeafSlots) return self;
+  Vec3 lo = Vec3::Constant(kInfinity), hi = -lo;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    lo = lo.cwiseMin(logMoments[order[i]]);
+    hi = hi.cwiseMax(logMoments[order[i]]);
+  }
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  const std::uint32_t leaves = (end - begin + kLeafSlots - 1) / kLeafSlots;
+  const std::uint32_t mid = begin + (leaves + 1) / 2 * kLeafSlots;
+  const auto at = [&order](std::uint32_t i) { return order.begin() + static_cast<std::ptrdiff_t>(i); };
+  std::nth_element(at(begin), at(mid), at(end), [&](std::uint32_t a, std::uint32_t b) {
+    return logMoments[a][axis] < logMoments[b][axis] ||
+           (logMoments[a][axis] == logMoments[b][axis] && ids[a] < ids[b]);
+  });
+  const std::int32_t left = arrangeClusters(order, begin, mid, logMoments, ids, clusters);
+  const std::int32_t right = arrangeClusters(order, mid, end, logMoments, ids, clusters);
+  clusters[static_cast<std::size_t>(self)].left = left;
+  clusters[static_cast<std::size_t>(self)].right = right;
+  return self;
+}
+
+float roundedDown(double x) {
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float roundedUp(double x) {
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+}  // namespace
+
 IndexBuilder::IndexBuilder(const DescriptorOptions& options) : mOptions(options) {
   const int n = options.gridSize;
   mWords = isGrid(options.kind) ? static_cast<std::uint32_t>((n * n * n + 63) / 64) : 0;
+}
+
+void IndexBuilder::reserve(std::size_t entries) {
+  mIds.reserve(entries);
+  mMoments.reserve(entries);
+  if (!isGrid(mOptions.kind)) return;
+  mCounts.reserve(entries);
+  mBits.reserve(entries * mWords);
+  mProfiles.reserve(entries * kProfileBytes);
+  if (mOptions.kind == DescriptorKind::kCentroidVoxel) mCentroidAt.reserve(entries);
+}
+
+std::size_t IndexBuilder::memoryBytes() const {
+  std::size_t chunks = bytesOf(mCentroidChunks);
+  for (const auto& chunk : mCentroidChunks)
+    chunks += bytesOf(chunk);
+  return bytesOf(mIds) + bytesOf(mMoments) + bytesOf(mCounts) + bytesOf(mBits) + bytesOf(mProfiles) +
+         bytesOf(mCentroidAt) + chunks;
 }
 
 Status IndexBuilder::add(EntryId id, const Descriptor& d) {
   if (Status valid = validateDescriptor(d, mOptions); !valid)
     return Error{valid.error().code, "entry " + std::to_string(id) + ": " + valid.error().message};
   mIds.push_back(id);
-  mMoments.push_back(d.moments);
-  if (!isGrid(d.kind)) return Ok{};
+  if (!isGrid(d.kind)) {
+    mMoments.push_back(d.moments);
+    return Ok{};
+  }
+  mMoments.push_back(logMoments(d.moments));
   mCounts.push_back(static_cast<std::uint32_t>(d.cells.size()));
   const std::size_t base = mBits.size();
   mBits.resize(base + mWords, 0);
   packOccupancy(d.cells, &mBits[base]);
-  if (mOptions.kind == DescriptorKind::kCentroidVoxel)
-    for (const Vec3& c : d.centroids)
-      mCentroids.push_back(quantizeCentroid(c));
-  mCentroidBegin.push_back(mCentroids.size());
+  const CountProfile profile = countProfile(&mBits[base], mOptions.gridSize);
+  mProfiles.insert(mProfiles.end(), profile.begin(), profile.end());
+  if (mOptions.kind != DescriptorKind::kCentroidVoxel) return Ok{};
+  if (mCentroidChunks.empty() || mCentroidChunks.back().size() + d.centroids.size() > kCentroidChunk) {
+    mCentroidChunks.emplace_back();
+    mCentroidChunks.back().reserve(std::max(kCentroidChunk, d.centroids.size()));
+  }
+  std::vector<std::uint16_t>& chunk = mCentroidChunks.back();
+  mCentroidAt.push_back((mCentroidChunks.size() - 1) << 32 | chunk.size());
+  for (const Vec3& c : d.centroids)
+    chunk.push_back(quantizeCentroid(c));
   return Ok{};
 }
 
 Result<Index> IndexBuilder::build() && {
-  auto impl = std::make_shared<Index::Impl>(mOptions);
-  Index::Impl& index = *impl;
   const std::size_t count = mIds.size();
   {
     std::vector<EntryId> sorted = mIds;
@@ -596,39 +821,36 @@ Result<Index> IndexBuilder::build() && {
     if (auto dup = std::adjacent_find(sorted.begin(), sorted.end()); dup != sorted.end())
       return Error{ErrorCode::kInvalidArgument, "entry " + std::to_string(*dup) + " added twice"};
   }
-  std::vector<std::size_t> order(count);
-  std::iota(order.begin(), order.end(), std::size_t{0});
+  auto impl = std::make_shared<Index::Impl>(mOptions);
+  Index::Impl& index = *impl;
+  std::vector<std::uint32_t> order(count);
+  std::iota(order.begin(), order.end(), std::uint32_t{0});
 
   if (!isGrid(mOptions.kind)) {
     // k-d tree: split the widest axis at the median, (value, id) ordered for determinism.
-    index.mIds = mIds;
-    index.mMoments = mMoments;
-    if (count == 0) return Index(std::move(impl));
+    if (count > 0) index.mNodes.push_back({0, static_cast<std::uint32_t>(count)});
     struct Range {
       std::uint32_t begin, end;
       std::int32_t node;
     };
-    index.mNodes.push_back({0, static_cast<std::uint32_t>(count)});
-    std::vector<Range> work = {{0, static_cast<std::uint32_t>(count), 0}};
-    std::vector<std::pair<Vec3, EntryId>> points(count);
-    for (std::size_t i = 0; i < count; ++i)
-      points[i] = {mMoments[i], mIds[i]};
+    std::vector<Range> work;
+    if (count > 0) work.push_back({0, static_cast<std::uint32_t>(count), 0});
     while (!work.empty()) {
       const Range r = work.back();
       work.pop_back();
       if (r.end - r.begin <= kLeafSize) continue;
       Vec3 lo = Vec3::Constant(kInfinity), hi = -lo;
       for (std::uint32_t i = r.begin; i < r.end; ++i) {
-        lo = lo.cwiseMin(points[i].first);
-        hi = hi.cwiseMax(points[i].first);
+        lo = lo.cwiseMin(mMoments[order[i]]);
+        hi = hi.cwiseMax(mMoments[order[i]]);
       }
       int axis = 0;
       (hi - lo).maxCoeff(&axis);
       const std::uint32_t mid = r.begin + (r.end - r.begin) / 2;
-      std::nth_element(points.begin() + r.begin, points.begin() + mid, points.begin() + r.end,
-                       [axis](const auto& a, const auto& b) {
-                         return a.first[axis] < b.first[axis] ||
-                                (a.first[axis] == b.first[axis] && a.second < b.second);
+      std::nth_element(order.begin() + r.begin, order.begin() + mid, order.begin() + r.end,
+                       [&](std::uint32_t a, std::uint32_t b) {
+                         return mMoments[a][axis] < mMoments[b][axis] ||
+                                (mMoments[a][axis] == mMoments[b][axis] && mIds[a] < mIds[b]);
                        });
       const auto left = static_cast<std::int32_t>(index.mNodes.size());
       index.mNodes.push_back({r.begin, mid});
@@ -637,44 +859,99 @@ Result<Index> IndexBuilder::build() && {
       node.left = left;
       node.right = left + 1;
       node.axis = axis;
-      node.split = points[mid].first[axis];
+      node.split = mMoments[order[mid]][axis];
       work.push_back({r.begin, mid, left});
       work.push_back({mid, r.end, left + 1});
     }
-    for (std::size_t i = 0; i < count; ++i) {
-      index.mMoments[i] = points[i].first;
-      index.mIds[i] = points[i].second;
-    }
+    permute(mIds, 1, order);
+    permute(mMoments, 1, order);
+    index.mIds = std::move(mIds);
+    index.mMoments = std::move(mMoments);
     return Index(std::move(impl));
   }
 
-  // Voxel kinds: slots sorted by (filled count, id); buckets of equal count.
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+  // Voxel kinds: slots sorted by (filled count, id) into buckets of equal count, each bucket arranged
+  // into a cluster tree; then every array reordered in place (the centroids stay where they are: each slot
+  // knows where its own start).
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
     return mCounts[a] < mCounts[b] || (mCounts[a] == mCounts[b] && mIds[a] < mIds[b]);
   });
-  index.mIds.resize(count);
-  index.mCounts.resize(count);
-  index.mBits.resize(count * mWords);
-  index.mProfiles.resize(count);
-  index.mCentroidBegin.assign(count + 1, 0);
-  index.mCentroids.reserve(mCentroids.size());
-  index.mLogMoments.resize(count);
-  for (std::size_t slot = 0; slot < count; ++slot) {
-    const std::size_t i = order[slot];
-    index.mIds[slot] = mIds[i];
-    index.mCounts[slot] = mCounts[i];
-    index.mLogMoments[slot] = logMoments(mMoments[i]);
-    std::copy_n(&mBits[i * mWords], mWords, &index.mBits[slot * mWords]);
-    index.mProfiles[slot] = countProfile(&mBits[i * mWords], mOptions.gridSize);
-    index.mCentroids.insert(index.mCentroids.end(),
-                            mCentroids.begin() + static_cast<std::ptrdiff_t>(mCentroidBegin[i]),
-                            mCentroids.begin() + static_cast<std::ptrdiff_t>(mCentroidBegin[i + 1]));
-    index.mCentroidBegin[slot + 1] = index.mCentroids.size();
+  for (std::size_t begin = 0; begin < count;) {
+    std::size_t end = begin;
+    while (end < count && mCounts[order[end]] == mCounts[order[begin]])
+      ++end;
+    index.mBucketRoot[mCounts[order[begin]]] =
+        arrangeClusters(order, static_cast<std::uint32_t>(begin), static_cast<std::uint32_t>(end), mMoments,
+                        mIds, index.mClusters);
+    begin = end;
   }
+  permute(mIds, 1, order);
+  permute(mMoments, 1, order);
+  permute(mCounts, 1, order);
+  permute(mBits, mWords, order);
+  permute(mProfiles, kProfileBytes, order);
+  if (mOptions.kind == DescriptorKind::kCentroidVoxel) permute(mCentroidAt, 1, order);
+  order = {};
+  index.mIds = std::move(mIds);
+  index.mMoments = std::move(mMoments);
+  index.mCounts = std::move(mCounts);
+  index.mBits = std::move(mBits);
+  index.mProfiles = std::move(mProfiles);
+  index.mCentroidAt = std::move(mCentroidAt);
+  index.mCentroidChunks = std::move(mCentroidChunks);
+
   for (std::size_t slot = 0; slot < count; ++slot)
     ++index.mBucketBegin[index.mCounts[slot] + 1];
   for (std::size_t c = 1; c < index.mBucketBegin.size(); ++c)
     index.mBucketBegin[c] += index.mBucketBegin[c - 1];
+  // The clusters' ranges, leaves from their slots, inner nodes from their children (which follow them).
+  const std::size_t words = mWords;
+  index.mClusterBits.assign(index.mClusters.size() * 2 * words, 0);
+  for (std::size_t c = index.mClusters.size(); c-- > 0;) {
+    Index::Impl::Cluster& cluster = index.mClusters[c];
+    std::uint64_t* all = &index.mClusterBits[c * 2 * words];
+    std::uint64_t* any = all + words;
+    if (cluster.left >= 0) {
+      const auto l = static_cast<std::size_t>(cluster.left), r = static_cast<std::size_t>(cluster.right);
+      const Index::Impl::Cluster& a = index.mClusters[l];
+      const Index::Impl::Cluster& b = index.mClusters[r];
+      for (std::size_t w = 0; w < words; ++w) {
+        all[w] = index.mClusterBits[l * 2 * words + w] & index.mClusterBits[r * 2 * words + w];
+        any[w] =
+            index.mClusterBits[l * 2 * words + words + w] | index.mClusterBits[r * 2 * words + words + w];
+      }
+      for (std::size_t i = 0; i < kProfileBytes; ++i) {
+        cluster.least[i] = std::min(a.least[i], b.least[i]);
+        cluster.most[i] = std::max(a.most[i], b.most[i]);
+      }
+      for (std::size_t axis = 0; axis < 3; ++axis) {
+        cluster.lowest[axis] = std::min(a.lowest[axis], b.lowest[axis]);
+        cluster.highest[axis] = std::max(a.highest[axis], b.highest[axis]);
+      }
+      continue;
+    }
+    cluster.least.fill(255);
+    cluster.most.fill(0);
+    std::fill_n(all, words, ~std::uint64_t{0});
+    Vec3 lo = Vec3::Constant(kInfinity), hi = -lo;
+    for (std::uint32_t slot = cluster.begin; slot < cluster.end; ++slot) {
+      for (std::size_t w = 0; w < words; ++w) {
+        all[w] &= index.mBits[slot * words + w];
+        any[w] |= index.mBits[slot * words + w];
+      }
+      const std::uint8_t* p = index.profile(slot);
+      for (std::size_t i = 0; i < kProfileBytes; ++i) {
+        cluster.least[i] = std::min(cluster.least[i], p[i]);
+        cluster.most[i] = std::max(cluster.most[i], p[i]);
+      }
+      lo = lo.cwiseMin(index.mMoments[slot]);
+      hi = hi.cwiseMax(index.mMoments[slot]);
+    }
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      cluster.lowest[axis] = roundedDown(lo[static_cast<Eigen::Index>(axis)]);
+      cluster.highest[axis] = roundedUp(hi[static_cast<Eigen::Index>(axis)]);
+    }
+  }
   return Index(std::move(impl));
 }
 

@@ -3,6 +3,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -100,8 +101,8 @@ void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queri
     if (::testing::Test::HasFailure()) break;
   }
   std::cout << "  " << toString(kind) << ": pruned search computed " << pruned.distanceEvaluations
-            << " distances, " << pruned.boundEvaluations << " bounds; brute force "
-            << brute.distanceEvaluations << " distances\n";
+            << " distances, " << pruned.boundEvaluations << " entry bounds, " << pruned.groupBoundEvaluations
+            << " group bounds; brute force " << brute.distanceEvaluations << " distances\n";
   EXPECT_LT(pruned.distanceEvaluations, brute.distanceEvaluations / 4);
 }
 
@@ -206,6 +207,36 @@ TEST(Index, TiesBreakByEntryId) {
     EXPECT_EQ(m[1].entry, 7u);
     EXPECT_EQ(m[2].entry, 19u);
   }
+}
+
+// Many entries alike, with ids in no order, fill buckets with several groups of identical bounds: the
+// k best, ties broken by id, are still brute force's, on one thread and on many.
+TEST(Index, TiesAcrossGroupsBreakByEntryId) {
+  const std::vector<Descriptor> bases = baseDescriptors(DescriptorKind::kCentroidVoxel, 3, 13);
+  std::mt19937_64 rng(14);
+  std::vector<EntryId> ids(300);
+  std::iota(ids.begin(), ids.end(), EntryId{1});
+  std::shuffle(ids.begin(), ids.end(), rng);
+  IndexBuilder builder(test::descriptorOptions(DescriptorKind::kCentroidVoxel));
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ASSERT_TRUE(
+        builder.add(ids[i], i % 3 == 0 ? test::jitterDescriptor(bases[i % 3], rng, 1, 0.0) : bases[i % 3])
+            .ok());
+  Result<Index> index = std::move(builder).build();
+  ASSERT_TRUE(index.ok());
+  for (const Descriptor& query : bases)
+    for (int k : {1, 17, 40}) {
+      SearchOptions options;
+      options.k = k;
+      options.method = SearchMethod::kBruteForce;
+      const std::vector<Match> expected = searchOrDie(*index, std::span(&query, 1), options);
+      options.method = SearchMethod::kPruned;
+      for (bool parallel : {true, false}) {
+        options.parallel = parallel;
+        expectSameMatches(searchOrDie(*index, std::span(&query, 1), options), expected,
+                          "k " + std::to_string(k) + (parallel ? "" : ", one thread"));
+      }
+    }
 }
 
 TEST(Index, PaperBucketsMissWhatTheExactSearchFinds) {

@@ -55,17 +55,21 @@ struct SearchOptions {
 
 /// What a search did, for benchmarks and tests.
 struct SearchStats {
-  std::size_t distanceEvaluations = 0;  ///< full descriptor distances computed
-  std::size_t boundEvaluations = 0;     ///< per-entry (or per-node) lower bounds computed
+  std::size_t distanceEvaluations = 0;    ///< full descriptor distances computed
+  std::size_t boundEvaluations = 0;       ///< per-entry (or per-node) lower bounds computed
+  std::size_t groupBoundEvaluations = 0;  ///< voxel kinds: lower bounds of a cluster of entries computed
 };
 
 /// The descriptors of every database entry in RAM, in a compact layout, with k-nearest search.
 ///
-/// Layout (voxel kinds): entries sorted by filled-cell count; per entry the occupancy bit-packed
-/// (⌈N³/64⌉ words), its filled-cell counts per slab and per block (CountProfile, the lower bounds),
-/// the logarithms of its moments (the moment term), and for centroid-voxel the centroid of each filled
-/// cell quantized to 31 levels per axis (5 bits, 2 bytes a centroid; 0.5 is the middle of a level, so a
-/// centroid there is robust to round-off).
+/// Layout (voxel kinds): entries sorted by filled-cell count into buckets of equal count, and within a
+/// bucket into a tree of clusters of similar proportions (a k-d tree over their moments, up to 16
+/// entries a leaf); per entry the occupancy bit-packed (⌈N³/64⌉ words), its filled-cell counts per slab
+/// and per block (the lower bounds), the logarithms of its moments (the moment term), and for
+/// centroid-voxel the centroid of each filled cell quantized to 31 levels per axis (5 bits, 2 bytes a
+/// centroid; 0.5 is the middle of a level, so a centroid there is robust to round-off). Per cluster,
+/// the range of each of those counts and moments: one bound for all its entries, so that a search
+/// skips most of a bucket without looking at its entries.
 /// Moment descriptors: a k-d tree over the three moments.
 ///
 /// Distances are those of core::descriptorDistance on the quantized centroids (each coordinate moves
@@ -105,14 +109,23 @@ class Index {
 };
 
 /// Collects entries and builds an Index. One per build; not thread-safe.
+///
+/// The entries are compacted as they are added, into the arrays the Index searches, and build() reorders
+/// those arrays in place and hands them over: at no time is the index held twice. reserve() spares the
+/// fixed-size arrays their growth; the centroids grow in chunks that are never moved.
 class IndexBuilder {
  public:
   explicit IndexBuilder(const DescriptorOptions& options);
+
+  /// Makes room for this many entries in all, so that adding them moves nothing.
+  void reserve(std::size_t entries);
 
   /// Adds one entry; the descriptor is compacted at once and not kept.
   /// Errors: kInvalidArgument for a descriptor of another kind, sampling or grid size.
   Status add(EntryId id, const Descriptor& descriptor);
   std::size_t size() const { return mIds.size(); }
+  /// Bytes held so far (capacity included).
+  std::size_t memoryBytes() const;
 
   /// The index of every entry added. Errors: kInvalidArgument if an id was added twice.
   Result<Index> build() &&;
@@ -121,11 +134,12 @@ class IndexBuilder {
   DescriptorOptions mOptions;
   std::uint32_t mWords = 0;
   std::vector<EntryId> mIds;
-  std::vector<std::uint32_t> mCounts;
-  std::vector<std::uint64_t> mBits;
-  std::vector<std::uint64_t> mCentroidBegin{0};
-  std::vector<std::uint16_t> mCentroids;
-  std::vector<Vec3> mMoments;  ///< every kind: the moment term of the voxel kinds, the tree of the other
+  std::vector<Vec3> mMoments;              ///< the moments (moment kind) or their logarithms (voxel kinds)
+  std::vector<std::uint32_t> mCounts;      ///< voxel kinds: filled cells
+  std::vector<std::uint64_t> mBits;        ///< voxel kinds: occupancy, mWords words each
+  std::vector<std::uint8_t> mProfiles;     ///< voxel kinds: the counts the lower bounds compare
+  std::vector<std::uint64_t> mCentroidAt;  ///< centroid-voxel: chunk << 32 | offset of the first centroid
+  std::vector<std::vector<std::uint16_t>> mCentroidChunks;  ///< the quantized centroids
 };
 
 /// A centroid in its cell's unit cube, quantized to 31 levels per axis, 5 bits each (x in the low bits).
