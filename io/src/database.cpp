@@ -184,11 +184,14 @@ Result<Database> Database::open(const std::filesystem::path& path, const OpenOpt
     core::DescriptorOptions o = impl->store.parameters().entry.descriptor;
     o.kind = kind;
     core::IndexBuilder builder(o);
-    auto descriptors = impl->store.descriptors(kind);
-    if (!descriptors) return descriptors.error();
-    for (const auto& [id, d] : *descriptors)
-      if (Status st = builder.add(id, d); !st)
-        return withContext(st.error(), path.string() + ": entry " + std::to_string(id));
+    builder.reserve(impl->entries.size());
+    const Status read =
+        impl->store.forEachDescriptor(kind, [&](core::EntryId id, const core::Descriptor& d) -> Status {
+          if (Status st = builder.add(id, d); !st)
+            return withContext(st.error(), path.string() + ": entry " + std::to_string(id));
+          return Ok{};
+        });
+    if (!read) return read.error();
     auto index = std::move(builder).build();
     if (!index) return withContext(index.error(), path.string());
     impl->indexes[static_cast<std::size_t>(kind)] =

@@ -521,12 +521,12 @@ Result<std::vector<FailureRecord>> Store::failures() const {
   return failures;
 }
 
-Result<std::vector<std::pair<core::EntryId, core::Descriptor>>> Store::descriptors(
-    core::DescriptorKind kind) const {
+Status Store::forEachDescriptor(
+    core::DescriptorKind kind,
+    const std::function<Status(core::EntryId, const core::Descriptor&)>& visit) const {
   Statement s(mImpl->db, "SELECT entry_id, data, checksum FROM descriptors WHERE kind = ? ORDER BY entry_id");
   if (!s.ok()) return mImpl->sqlError("reading descriptors");
   s.bind(1, static_cast<std::int64_t>(kind));
-  std::vector<std::pair<core::EntryId, core::Descriptor>> result;
   int rc = 0;
   while ((rc = s.step()) == SQLITE_ROW) {
     const auto id = static_cast<core::EntryId>(s.integer(0));
@@ -535,10 +535,10 @@ Result<std::vector<std::pair<core::EntryId, core::Descriptor>>> Store::descripto
       return Error{ErrorCode::kParse, where + ": descriptor checksum mismatch (the file is corrupted)"};
     auto d = decodeDescriptor(s.blob(1), s.blobSize(1));
     if (!d) return withContext(d.error(), where);
-    result.emplace_back(id, std::move(d).value());
+    if (Status st = visit(id, *d); !st) return st;
   }
   if (rc != SQLITE_DONE) return mImpl->sqlError("reading descriptors");
-  return result;
+  return Ok{};
 }
 
 Result<IntegrityReport> Store::check() const {

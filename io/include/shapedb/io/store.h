@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -130,9 +131,11 @@ class Store {
 
   Result<std::vector<EntryRecord>> entries() const;
   Result<std::vector<FailureRecord>> failures() const;
-  /// Every entry's descriptor of one kind, checksums verified.
-  Result<std::vector<std::pair<core::EntryId, core::Descriptor>>> descriptors(
-      core::DescriptorKind kind) const;
+  /// Every entry's descriptor of one kind, in id order, checksums verified, each handed to `visit` as
+  /// it is read (none is kept: an index of millions is built without the descriptors held twice).
+  /// Stops at the first error, `visit`'s own included.
+  Status forEachDescriptor(core::DescriptorKind kind,
+                           const std::function<Status(core::EntryId, const core::Descriptor&)>& visit) const;
   /// One entry's physical data, checksums verified. Errors: kInvalidArgument (no such entry), kParse
   /// (a corrupted blob: the message names the entry and the part).
   Result<core::PhysicalData> physics(core::EntryId id) const;
