@@ -15,6 +15,7 @@
 #include <shapedb/io/mesh_io.h>
 
 #include "mesh_format.h"
+#include "obj_writer.h"
 #include "openmesh_adapters.h"
 #include "text_mesh_readers.h"
 
@@ -141,12 +142,7 @@ void writeObj(const core::TriangleMesh& mesh, std::ostream& out) {
   std::snprintf(line, sizeof line, "# %zu vertices, %zu faces\n", mesh.vertices.size(),
                 mesh.triangles.size());
   out << line;
-  for (const core::Vec3& p : mesh.vertices) {
-    std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p.x(), p.y(), p.z());
-    out << line;
-  }
-  for (const auto& t : mesh.triangles)
-    out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+  detail::writeObjPart(out, mesh);
 }
 
 /// PLY with double coordinates and int indices; binary little-endian or ASCII.

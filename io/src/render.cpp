@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <memory>
 
@@ -8,6 +9,8 @@
 
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/render.h>
+
+#include "obj_writer.h"
 
 namespace shapedb::io {
 
@@ -126,19 +129,16 @@ std::vector<core::TriangleMesh> tessellate(const core::CollisionCompound& compou
 
 Status saveObjParts(std::span<const std::pair<std::string, core::TriangleMesh>> parts,
                     const std::filesystem::path& path) {
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
+  std::ofstream file(path);
   if (!file) return Error{ErrorCode::kIo, path.string() + ": cannot open for writing"};
-  std::fprintf(file.get(), "# written by shapedb\n");
-  std::size_t base = 1;
+  file << "# written by shapedb\n";
+  std::size_t base = 0;
   for (const auto& [name, mesh] : parts) {
-    std::fprintf(file.get(), "o %s\n", name.c_str());
-    for (const core::Vec3& v : mesh.vertices)
-      std::fprintf(file.get(), "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
-    for (const auto& t : mesh.triangles)
-      std::fprintf(file.get(), "f %zu %zu %zu\n", t[0] + base, t[1] + base, t[2] + base);
+    detail::writeObjPart(file, mesh, base, name);
     base += mesh.vertices.size();
   }
-  if (std::ferror(file.get())) return Error{ErrorCode::kIo, path.string() + ": write failed"};
+  file.close();
+  if (!file) return Error{ErrorCode::kIo, path.string() + ": write failed"};
   return Ok{};
 }
 
