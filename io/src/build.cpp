@@ -463,13 +463,17 @@ Result<MergeReport> mergeDatabases(const std::filesystem::path& out,
                                                   " missing: a merge needs every part of the catalog"};
 
   // Written beside `out` and renamed onto it once whole (a stale file of an interrupted merge is ours).
+  // A merge that fails removes what it wrote.
   std::filesystem::path partial = out;
   partial += ".merging";
-  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
-    std::filesystem::remove(partial.string() + suffix, ec);
+  const auto removePartial = [&partial, &ec] {
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+      std::filesystem::remove(partial.string() + suffix, ec);
+  };
+  removePartial();
   MergeReport report;
   report.shards = parts.size();
-  {
+  const Status written = [&]() -> Status {
     Result<Store> created = Store::create(partial, first.store.parameters());
     if (!created) return created.error();
     Store& merged = *created;
@@ -505,7 +509,12 @@ Result<MergeReport> mergeDatabases(const std::filesystem::path& out,
     static_cast<void>(merged.finish());
     report.entries = total;
     report.failures = failures.size();
-  }  // closed: a last connection's close also folds any write-ahead log into the file
+    return Ok{};
+  }();  // closed: a last connection's close also folds any write-ahead log into the file
+  if (!written) {
+    removePartial();
+    return written.error();
+  }
   for (const char* suffix : {"-wal", "-shm"})
     if (std::filesystem::exists(partial.string() + suffix, ec))
       return Error{ErrorCode::kIo, partial.string() + suffix + ": left over after closing; the merge is in " +

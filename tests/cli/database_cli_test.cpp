@@ -184,7 +184,7 @@ TEST(BuildCli, ShardsBuiltSeparatelyAndMergedEqualASingleBuild) {
   EXPECT_EQ(exists.exitCode, 1);
   EXPECT_NE(exists.err.find("exists"), std::string::npos) << exists.err;
 
-  // A damaged blob in a shard is found on the way, named, and nothing is written.
+  // A damaged blob in a shard is found on the way, named, and nothing is written or left behind.
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open((dir / "part2.db").c_str(), &db), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db, "UPDATE physics SET data = X'00' WHERE entry_id = 2 AND part = 2", nullptr,
@@ -197,6 +197,8 @@ TEST(BuildCli, ShardsBuiltSeparatelyAndMergedEqualASingleBuild) {
   EXPECT_EQ(damaged.exitCode, 1);
   EXPECT_NE(damaged.err.find("physics part 2 does not match its checksum"), std::string::npos) << damaged.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "refused.db"));
+  for (const char* leftover : {"refused.db.merging", "refused.db.merging-wal", "refused.db.merging-shm"})
+    EXPECT_FALSE(std::filesystem::exists(dir / leftover)) << leftover;
 }
 
 #ifdef SHAPEDB_MPIEXEC
