@@ -201,6 +201,7 @@ struct Index::Impl {
   struct Cluster {
     std::uint32_t begin = 0, end = 0;    ///< slots
     std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
+    std::uint32_t count = 0;             ///< its bucket's filled-cell count
     std::array<float, 3> lowest{};       ///< least ln moment per axis, rounded down
     std::array<float, 3> highest{};      ///< greatest, rounded up
     CountProfile least, most;            ///< per part of every partition
@@ -416,7 +417,7 @@ double Index::Impl::gridBound(const Query& q, std::size_t slot, double moments) 
 // so no larger in floating point either. Returns as soon as the terms so far exceed `threshold`.
 double Index::Impl::clusterBound(const Query& q, std::int32_t index, double threshold) const {
   const Cluster& cluster = mClusters[static_cast<std::size_t>(index)];
-  const std::uint32_t count = mCounts[cluster.begin];
+  const std::uint32_t count = cluster.count;
   double moments = 0.0;
   if (q.momentWeight != 0.0) {
     const auto outside = [&](int axis) {
@@ -491,6 +492,11 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
       if (pending.bound > std::min(shared, local.threshold())) continue;
       const Cluster& cluster = mClusters[static_cast<std::size_t>(pending.cluster)];
       if (cluster.left >= 0) {
+        // Both children's loads at once, rather than one after the other: the walk is bound by memory.
+        for (const std::int32_t child : {cluster.left, cluster.right}) {
+          __builtin_prefetch(&mClusters[static_cast<std::size_t>(child)]);
+          __builtin_prefetch(&mClusterBits[static_cast<std::size_t>(child) * 2 * mWords]);
+        }
         const double threshold = std::min(shared, local.threshold());
         const Pending left{cluster.left, clusterBound(q, cluster.left, threshold)};
         const Pending right{cluster.right, clusterBound(q, cluster.right, threshold)};
@@ -915,6 +921,7 @@ Result<Index> IndexBuilder::build() && {
       const auto l = static_cast<std::size_t>(cluster.left), r = static_cast<std::size_t>(cluster.right);
       const Index::Impl::Cluster& a = index.mClusters[l];
       const Index::Impl::Cluster& b = index.mClusters[r];
+      cluster.count = a.count;
       for (std::size_t w = 0; w < words; ++w) {
         all[w] = index.mClusterBits[l * 2 * words + w] & index.mClusterBits[r * 2 * words + w];
         any[w] =
@@ -930,6 +937,7 @@ Result<Index> IndexBuilder::build() && {
       }
       continue;
     }
+    cluster.count = index.mCounts[cluster.begin];
     cluster.least.fill(255);
     cluster.most.fill(0);
     std::fill_n(all, words, ~std::uint64_t{0});
