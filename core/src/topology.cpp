@@ -1,37 +1,13 @@
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <string>
 #include <vector>
 
+#include <shapedb/core/disjoint_sets.h>
 #include <shapedb/core/topology.h>
 
 namespace shapedb::core {
 namespace {
-
-// Disjoint sets over vertex indices, with path halving and union by size.
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t n) : mParent(n), mSize(n, 1) {
-    std::iota(mParent.begin(), mParent.end(), 0u);
-  }
-  std::uint32_t find(std::uint32_t x) {
-    while (mParent[x] != x)
-      x = mParent[x] = mParent[mParent[x]];
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a), b = find(b);
-    if (a == b) return;
-    if (mSize[a] < mSize[b]) std::swap(a, b);
-    mParent[b] = a;
-    mSize[a] += mSize[b];
-  }
-
- private:
-  std::vector<std::uint32_t> mParent;
-  std::vector<std::uint32_t> mSize;
-};
 
 bool hasRepeatedVertex(const TriangleMesh::Triangle& t) {
   return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
