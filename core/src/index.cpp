@@ -153,10 +153,17 @@ Vec3 logMoments(const Vec3& moments) {
   return moments.cwiseMax(std::numeric_limits<double>::min()).array().log().matrix();
 }
 
-// Bytes a vector holds, capacity included.
+// Bytes a vector holds, capacity included; of a vector of vectors (the centroid chunks), theirs too.
 template <class T>
 std::size_t bytesOf(const std::vector<T>& v) {
   return v.capacity() * sizeof(T);
+}
+template <class T>
+std::size_t bytesOf(const std::vector<std::vector<T>>& chunks) {
+  std::size_t bytes = chunks.capacity() * sizeof(std::vector<T>);
+  for (const std::vector<T>& chunk : chunks)
+    bytes += bytesOf(chunk);
+  return bytes;
 }
 
 inline bool isGrid(DescriptorKind kind) {
@@ -321,12 +328,9 @@ Index::Impl::Impl(const DescriptorOptions& options) : mOptions(options) {
 }
 
 std::size_t Index::Impl::memoryBytes() const {
-  std::size_t chunks = bytesOf(mCentroidChunks);
-  for (const auto& chunk : mCentroidChunks)
-    chunks += bytesOf(chunk);
   return bytesOf(mIds) + bytesOf(mMoments) + bytesOf(mCounts) + bytesOf(mBits) + bytesOf(mProfiles) +
-         bytesOf(mCentroidAt) + chunks + bytesOf(mBucketBegin) + bytesOf(mBucketRoot) + bytesOf(mClusters) +
-         bytesOf(mClusterBits) + bytesOf(mNodes);
+         bytesOf(mCentroidAt) + bytesOf(mCentroidChunks) + bytesOf(mBucketBegin) + bytesOf(mBucketRoot) +
+         bytesOf(mClusters) + bytesOf(mClusterBits) + bytesOf(mNodes);
 }
 
 Index::Impl::Query Index::Impl::prepare(const Descriptor& d, int candidate, double momentWeight) const {
@@ -785,11 +789,8 @@ void IndexBuilder::reserve(std::size_t entries) {
 }
 
 std::size_t IndexBuilder::memoryBytes() const {
-  std::size_t chunks = bytesOf(mCentroidChunks);
-  for (const auto& chunk : mCentroidChunks)
-    chunks += bytesOf(chunk);
   return bytesOf(mIds) + bytesOf(mMoments) + bytesOf(mCounts) + bytesOf(mBits) + bytesOf(mProfiles) +
-         bytesOf(mCentroidAt) + chunks;
+         bytesOf(mCentroidAt) + bytesOf(mCentroidChunks);
 }
 
 Status IndexBuilder::add(EntryId id, const Descriptor& d) {
