@@ -1,12 +1,16 @@
 // The spatial searches against brute force: the closest point on a surface (ClosestPointTree) and the
 // tet holding a point, or the nearest boundary point outside (TetLocator).
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <numeric>
 #include <random>
 
 #include <gtest/gtest.h>
 
+#include <shapedb/core/physics.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/spatial.h>
 
@@ -102,6 +106,46 @@ TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
   // The grid fills 72 of the sampled 378 units³: about 1,520 points inside, the rest outside.
   EXPECT_GT(inside, 1000);
   EXPECT_LT(inside, 2000);
+}
+
+// boundaryFaces (a counting sort by smallest node) against faces counted in a map: the same faces, the
+// same winding and owner, in the order of their sorted nodes. Random tets are taken out of a jittered grid,
+// which leaves inner cavities and faces that two removed tets shared, and the nodes are renumbered at
+// random, so that a node's faces come from anywhere in the tet list.
+TEST(BoundaryFaces, AgreeWithFacesCountedInAMap) {
+  std::mt19937_64 rng(12);
+  for (int round = 0; round < 20; ++round) {
+    TetMesh mesh = test::makeTetGrid(5, 4, 3, 0.3, rng);
+    std::shuffle(mesh.tets.begin(), mesh.tets.end(), rng);
+    mesh.tets.resize(mesh.tets.size() * static_cast<std::size_t>(60 + round) / 100);
+    std::vector<std::uint32_t> renumber(mesh.nodes.size());
+    std::iota(renumber.begin(), renumber.end(), 0u);
+    std::shuffle(renumber.begin(), renumber.end(), rng);
+    for (TetMesh::Tet& tet : mesh.tets)
+      for (std::uint32_t& v : tet)
+        v = renumber[v];
+
+    std::map<std::array<std::uint32_t, 3>, std::vector<BoundaryFace>> seen;
+    for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
+      const auto& [a, b, c, d] = mesh.tets[t];
+      for (const std::array<std::uint32_t, 3>& f :
+           {std::array{a, c, b}, std::array{a, b, d}, std::array{b, c, d}, std::array{a, d, c}}) {
+        std::array<std::uint32_t, 3> key = f;
+        std::sort(key.begin(), key.end());
+        seen[key].push_back({f, t});
+      }
+    }
+    std::vector<BoundaryFace> expected;
+    for (const auto& [key, faces] : seen)
+      if (faces.size() == 1) expected.push_back(faces.front());
+
+    const std::vector<BoundaryFace> found = boundaryFaces(mesh);
+    ASSERT_EQ(found.size(), expected.size()) << "round " << round;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      ASSERT_EQ(found[i].nodes, expected[i].nodes) << "round " << round << ", face " << i;
+      ASSERT_EQ(found[i].tet, expected[i].tet) << "round " << round << ", face " << i;
+    }
+  }
 }
 
 }  // namespace
