@@ -88,6 +88,15 @@ Status checkOptions(std::size_t nodeCount, const ModalOptions& options) {
     return Error{ErrorCode::kInvalidArgument, "Young's modulus and density must be finite and positive"};
   if (!core::validPoissonRatio(m.poissonRatio))
     return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in [0, 0.5)"};
+  if (!options.pointMasses.empty()) {
+    if (options.pointMasses.size() != nodeCount)
+      return Error{ErrorCode::kInvalidArgument,
+                   "point masses: " + std::to_string(options.pointMasses.size()) + " given for a mesh of " +
+                       std::to_string(nodeCount) + " nodes"};
+    for (double mass : options.pointMasses)
+      if (!(mass >= 0.0 && std::isfinite(mass)))
+        return Error{ErrorCode::kInvalidArgument, "point masses must be finite and not negative"};
+  }
   if (3 * nodeCount < static_cast<std::size_t>(options.modes) + 6 + 2)
     return Error{ErrorCode::kInvalidArgument,
                  "the tet mesh has too few nodes for " + std::to_string(options.modes) + " modes"};
@@ -475,6 +484,19 @@ Result<ModalData> solveDense(const FemMatrices& fem, const ModalOptions& options
                        fem, options);
 }
 
+/// K and M of `mesh` with options.pointMasses added to M's diagonal, three degrees of freedom per node (the
+/// first nodes: a quadratic mesh numbers its corners first).
+template <class Mesh>
+FemMatrices assemble(const Mesh& mesh, const ModalOptions& options) {
+  FemMatrices fem = assembleFem(mesh, options.material);
+  for (std::size_t i = 0; i < options.pointMasses.size(); ++i)
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      const Eigen::Index dof = 3 * static_cast<Eigen::Index>(i) + k;
+      fem.mass.coeffRef(dof, dof) += options.pointMasses[i];
+    }
+  return fem;
+}
+
 /// The quadratic modes at the corners only.
 Result<ModalData> cornersOnly(Result<ModalData> modes, std::size_t cornerCount) {
   if (!modes) return modes;
@@ -487,16 +509,16 @@ Result<ModalData> cornersOnly(Result<ModalData> modes, std::size_t cornerCount) 
 
 Result<ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOptions& options) {
   if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
-  return solveSparse(mesh.nodes, assembleFem(mesh, options.material), options);
+  return solveSparse(mesh.nodes, assemble(mesh, options), options);
 }
 
 Result<ModalData> computeModes(const TetMesh& mesh, const ModalOptions& options) {
-  if (options.order == ElementOrder::kQuadratic) {
-    if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
-    return cornersOnly(computeModes(makeQuadratic(mesh), options), mesh.nodeCount());
-  }
   if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
-  return solveSparse(mesh.nodes, assembleFem(mesh, options.material), options);
+  if (options.order == ElementOrder::kQuadratic) {
+    const QuadraticTetMesh quadratic = makeQuadratic(mesh);
+    return cornersOnly(solveSparse(quadratic.nodes, assemble(quadratic, options), options), mesh.nodeCount());
+  }
+  return solveSparse(mesh.nodes, assemble(mesh, options), options);
 }
 
 Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& seeds,
@@ -516,11 +538,11 @@ Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& s
   };
   if (options.order == ElementOrder::kQuadratic) {
     const QuadraticTetMesh quadratic = makeQuadratic(mesh);
-    const FemMatrices fem = assembleFem(quadratic, options.material);
+    const FemMatrices fem = assemble(quadratic, options);
     const Eigen::VectorXd v = start(fem, seedsAtAllNodes(quadratic, seeds));
     return cornersOnly(solveSparse(quadratic.nodes, fem, options, &v, solves), mesh.nodeCount());
   }
-  const FemMatrices fem = assembleFem(mesh, options.material);
+  const FemMatrices fem = assemble(mesh, options);
   const Eigen::VectorXd v = start(fem, seeds);
   return solveSparse(mesh.nodes, fem, options, &v, solves);
 }
@@ -529,9 +551,9 @@ Result<ModalData> computeModesDense(const TetMesh& mesh, const ModalOptions& opt
   if (Status ok = checkOptions(mesh.nodeCount(), options); !ok) return ok.error();
   if (options.order == ElementOrder::kQuadratic) {
     const QuadraticTetMesh quadratic = makeQuadratic(mesh);
-    return cornersOnly(solveDense(assembleFem(quadratic, options.material), options), mesh.nodeCount());
+    return cornersOnly(solveDense(assemble(quadratic, options), options), mesh.nodeCount());
   }
-  return solveDense(assembleFem(mesh, options.material), options);
+  return solveDense(assemble(mesh, options), options);
 }
 
 }  // namespace shapedb::volume

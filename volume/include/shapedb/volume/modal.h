@@ -69,6 +69,10 @@ struct ModalOptions {
   /// its nodes (the corners; the mid-edge values are dropped). Linear: constant-strain tets, which lock in
   /// bending (a plate two or three tets thick rings tens of per cent high) unless the mesh is very fine.
   ElementOrder order = ElementOrder::kQuadratic;
+  /// Masses lumped at the mesh's nodes (the corners), one per node, added to the mass matrix's diagonal
+  /// beside the tets' own; empty for none. The geometry correction puts there the mass of what its
+  /// morphed tets do not reach. Each must be finite and ≥ 0.
+  std::vector<double> pointMasses{};
 };
 
 /// The first `modes` non-rigid modes of the free body, K φ = λ M φ, by shift-invert Lanczos (Spectra)
