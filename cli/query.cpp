@@ -110,7 +110,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mean_boundary_move", c.morph.meanBoundaryMove},
           {"mean_target_distance", c.morph.meanTargetDistance},
           {"projected", c.morph.projected},
-          {"volume_scale", c.volumeScale},
+          {"mass_scale", c.massScale},
           {"morphs", c.morphs},
           {"solves", c.solves},
           {"morph_seconds", c.morphSeconds},

@@ -172,7 +172,7 @@ py::dict correctionDict(const volume::CorrectionReport& r) {
                   "worst_quality"_a = m.worstQuality, "max_boundary_move"_a = m.maxBoundaryMove,
                   "mean_boundary_move"_a = m.meanBoundaryMove,
                   "mean_target_distance"_a = m.meanTargetDistance, "projected"_a = m.projected,
-                  "volume_scale"_a = r.volumeScale, "solves"_a = r.solves, "morphs"_a = r.morphs,
+                  "mass_scale"_a = r.massScale, "solves"_a = r.solves, "morphs"_a = r.morphs,
                   "morph_seconds"_a = r.morphSeconds, "modes_seconds"_a = r.modesSeconds);
 }
 

@@ -1,7 +1,11 @@
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
+#include <vector>
 
 #include <shapedb/core/mass_properties.h>
+#include <shapedb/core/spatial.h>
 #include <shapedb/volume/correction.h>
 
 namespace shapedb::volume {
@@ -11,6 +15,35 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// `mass` shared among the nodes of `tets` next to where `target` lies outside them (MorphedEntry::
+// pointMasses); empty if no vertex of the target lies outside.
+std::vector<double> missingMass(const core::TetMesh& tets, const core::TriangleMesh& target, double mass) {
+  std::vector<double> area(target.vertices.size(), 0.0);
+  for (const auto& t : target.triangles) {
+    const core::Vec3& a = target.vertices[t[0]];
+    const double third = (target.vertices[t[1]] - a).cross(target.vertices[t[2]] - a).norm() / 6.0;
+    for (const std::uint32_t v : t)
+      area[v] += third;
+  }
+  const core::TetLocator locator(tets);
+  core::TetLocator::Hint hint;
+  std::vector<double> share(tets.nodeCount(), 0.0);
+  for (std::size_t v = 0; v < target.vertices.size(); ++v) {
+    const core::TetLocation at = locator.locate(target.vertices[v], hint);
+    if (at.inside() || area[v] == 0.0) continue;
+    const double gap = area[v] * at.distance;
+    // The closest point is on a boundary face of at.tet: the node across from it has weight 0, to
+    // round-off, which must not put mass inside.
+    for (std::size_t k = 0; k < 4; ++k)
+      if (at.weights[k] > 1e-9) share[tets.tets[at.tet][k]] += gap * at.weights[k];
+  }
+  const double total = std::accumulate(share.begin(), share.end(), 0.0);
+  if (!(total > 0.0)) return {};
+  for (double& s : share)
+    s *= mass / total;
+  return share;
 }
 
 }  // namespace
@@ -26,17 +59,20 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::Tri
   MorphedEntry out;
   out.report.morph = morphed->report;
   out.tetMesh = std::move(morphed->mesh);
-  // The morphed tets fill the target only as far as the projection went (a boundary node held back off a
-  // sharp edge cuts the corner): scaled about their centre of mass to the target's volume, so that their
-  // modes are those of a body of the query's size and mass, as an entry's are.
-  if (Result<core::MassProperties> targetMass = core::computeMassProperties(target); targetMass) {
-    const core::MassProperties own = core::computeTetMassProperties(out.tetMesh);
-    const double scale = std::cbrt(targetMass->volume / own.volume);
-    if (std::isfinite(scale) && scale > 0.0) {
-      out.report.volumeScale = scale;
-      for (core::Vec3& p : out.tetMesh.nodes)
-        p = own.centerOfMass + scale * (p - own.centerOfMass);
-    }
+  // The morphed tets fill the target only as far as the projection went: a boundary node held back off a
+  // sharp edge cuts the edge or the corner, and a part the entry has no tets for is left out. What is
+  // cut off is at the body's rim, mass where a mode moves most and little stiffness (a free edge carries
+  // no stress). So its mass is given back where it is missing, and not its volume: the target's
+  // vertices that lie outside the tets, each with a third of its triangles' area times its distance to
+  // them, share the missing mass among the corners of the boundary faces nearest to them. Scaling the tets
+  // up to the target's volume, as before, thickened the whole body, stiffness with the mass, and left the
+  // corrected first frequencies higher (docs/architecture.md).
+  Result<core::MassProperties> targetMass = core::computeMassProperties(target);
+  const double volume = core::computeTetMassProperties(out.tetMesh).volume;
+  if (targetMass && std::isfinite(targetMass->volume / volume) && targetMass->volume > 0.0) {
+    out.report.massScale = targetMass->volume / volume;
+    if (targetMass->volume > volume)
+      out.pointMasses = missingMass(out.tetMesh, target, targetMass->volume - volume);
   }
   out.report.morphSeconds = secondsSince(start);
   return out;
@@ -47,12 +83,17 @@ Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEn
   CorrectedEntry out;
   out.report = morphed.report;
   out.physics.tetMesh = std::move(morphed.tetMesh);
-  out.physics.massProperties = core::computeTetMassProperties(out.physics.tetMesh);
+  out.physics.massProperties = core::computeTetMassProperties(out.physics.tetMesh, out.report.massScale);
+  const bool lumped = !morphed.pointMasses.empty();
 
   // The entry's modes on the same nodes are the seeds: the morph moved the nodes, not their numbering.
   const Clock::time_point start = Clock::now();
   ModalOptions unit = modal;
   unit.material = core::unitMaterial(modal.material.poissonRatio);
+  if (lumped)
+    unit.pointMasses = std::move(morphed.pointMasses);
+  else
+    unit.material.density = out.report.massScale;
   auto modes = computeModesFrom(out.physics.tetMesh, entry.modes.shapes, unit, &out.report.solves);
   if (!modes) return withContext(modes.error(), "correction: modes on the morphed tets");
   out.physics.modes = std::move(modes).value();

@@ -19,9 +19,10 @@ struct CorrectionOptions {
 /// What the correction did and what it cost.
 struct CorrectionReport {
   MorphReport morph;  ///< quality, moves, target coverage: in the entry's canonical frame (L = 1)
-  /// The uniform scale that gave the morphed tets the target's volume (1 where the morph reached all of
-  /// the target; above 1 where held-back boundary nodes cut corners).
-  double volumeScale = 1.0;
+  /// The target's volume over the morphed tets': 1 where the morph reached all of the target; above 1
+  /// where boundary nodes held back cut its edges and corners, or left out a part the entry has no tets
+  /// for. The modes carry the target's whole mass all the same (MorphedEntry::pointMasses).
+  double massScale = 1.0;
   int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
   /// Entries morphed to choose this one from (a query's candidates, io::QueryOptions::correctionCandidates);
   /// morphSeconds is all of their morphs'.
@@ -31,33 +32,41 @@ struct CorrectionReport {
 };
 
 /// The corrected entry: PhysicalData in the entry's canonical frame as a database entry's (so that
-/// core::adapt carries it to the query like any entry), with the morphed tets and their mass properties,
-/// the modes computed on them (unit density and Young's modulus, the entry's Poisson ratio), their sound
-/// frequencies; the collision compound is the entry's.
+/// core::adapt carries it to the query like any entry: the target's mass, unit Young's modulus), with the
+/// morphed tets, the modes computed on them with the mass they lack lumped at their boundary
+/// (MorphedEntry::pointMasses; the entry's Poisson ratio), their sound frequencies, and their mass
+/// properties with that mass spread over them (the density report.massScale); the collision compound is
+/// the entry's.
 struct CorrectedEntry {
   core::PhysicalData physics;
   CorrectionReport report;
 };
 
-/// The correction's first half: `entry`'s tets morphed onto `target` and scaled to its volume; report has
-/// the morph, the volume scale and morphSeconds. How well the result reaches the target
+/// The correction's first half: `entry`'s tets morphed onto `target`; report has the morph, the mass
+/// scale and morphSeconds. How well the result reaches the target
 /// (report.morph.meanTargetDistance) is known here, before the modes cost anything: a query chooses among
 /// its best matches by it.
 struct MorphedEntry {
   core::TetMesh tetMesh;
   CorrectionReport report;
+  /// Per node of tetMesh, the mass lumped there (unit density; ModalOptions::pointMasses): the target's
+  /// volume the tets lack, shared among the boundary nodes next to where the target lies outside them, in
+  /// proportion to the area there times how far outside. Empty where the tets hold at least the target's
+  /// volume (their density is then lowered to give its mass) or nothing of the target lies outside them.
+  std::vector<double> pointMasses;
 };
 
 /// Morphs `entry`'s tets onto `target` (the query's surface carried into the entry's canonical frame:
-/// unit volume, the entry's axes, core::Placement::toEntry) and scales them about their centre of mass to
-/// its volume. Thread-safe. Errors: kInvalidArgument (the entry's modes do not fit its tets), morphTetMesh's
-/// (the morph would invert a tet: keep the entry's data).
+/// unit volume, the entry's axes, core::Placement::toEntry), and finds where the mass they lack goes
+/// (pointMasses, report.massScale). Thread-safe. Errors: kInvalidArgument (the entry's modes do not fit its
+/// tets), morphTetMesh's (the morph would invert a tet: keep the entry's data).
 Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::TriangleMesh& target,
                                 const CorrectionOptions& options = {});
 
 /// The correction's second half: the modes of `morphed` (morphEntry of this `entry`) computed with `modal`
-/// (the database's: count, elements, Poisson ratio; E = ρ = 1), seeded by the entry's modes; the entry's
-/// collision compound and damping. Thread-safe. Errors: computeModesFrom's.
+/// (the database's: count, elements, Poisson ratio; E = ρ = 1 and morphed.pointMasses, or ρ =
+/// report.massScale where there are none), seeded by the entry's modes; the entry's collision compound and
+/// damping. Thread-safe. Errors: computeModesFrom's.
 Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEntry morphed,
                                       const ModalOptions& modal);
 
