@@ -20,13 +20,7 @@ double secondsSince(Clock::time_point start) {
 // `mass` shared among the nodes of `tets` next to where `target` lies outside them (MorphedEntry::
 // pointMasses); empty if no vertex of the target lies outside.
 std::vector<double> missingMass(const core::TetMesh& tets, const core::TriangleMesh& target, double mass) {
-  std::vector<double> area(target.vertices.size(), 0.0);
-  for (const auto& t : target.triangles) {
-    const core::Vec3& a = target.vertices[t[0]];
-    const double third = (target.vertices[t[1]] - a).cross(target.vertices[t[2]] - a).norm() / 6.0;
-    for (const std::uint32_t v : t)
-      area[v] += third;
-  }
+  const std::vector<double> area = core::vertexAreaWeights(target);
   const core::TetLocator locator(tets);
   core::TetLocator::Hint hint;
   std::vector<double> share(tets.nodeCount(), 0.0);
