@@ -1,4 +1,5 @@
-// Fuzz target: one mesh file format (SHAPEDB_FUZZ_FORMAT: "obj", "ply", "off" or "stl"), read as users'
+// Fuzz target: one mesh file format (kShapedbFuzzFormat: "obj", "ply", "off" or "stl", defined by each
+// target in a source that tests/fuzz/CMakeLists.txt generates), read as users'
 // files are (io::loadMesh), then, when it loads as a closed surface, the front half of a query: exact
 // mass properties and the canonical frame. Properties checked beyond "no crash, no leak, no UB":
 // every error names the file; a mesh that loads is valid (indices in range, coordinates finite); a
@@ -12,9 +13,8 @@
 
 #include "fuzz_support.h"
 
-#ifndef SHAPEDB_FUZZ_FORMAT
-#error "SHAPEDB_FUZZ_FORMAT must name the format, e.g. \"obj\""
-#endif
+/// The format this target reads, as a file extension without its dot.
+extern const char kShapedbFuzzFormat[];
 
 namespace shapedb::fuzz {
 namespace {
@@ -48,7 +48,7 @@ void loadBothWays(const std::filesystem::path& path) {
 }  // namespace shapedb::fuzz
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::filesystem::path path = shapedb::fuzz::scratchPath("." SHAPEDB_FUZZ_FORMAT);
+  static const std::filesystem::path path = shapedb::fuzz::scratchPath(std::string(".") + kShapedbFuzzFormat);
   shapedb::fuzz::writeInput(path, data, size);
   shapedb::fuzz::loadBothWays(path);
   return 0;
