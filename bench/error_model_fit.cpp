@@ -105,6 +105,9 @@ std::vector<Sample> readSamples(const std::string& path, const std::string& meth
     e.outsideShare = number(f[column["outside_share"]]);
     const double morph = number(f[column["morph_target_distance"]]);
     if (std::isfinite(morph)) e.morphTargetDistance = morph;
+    // Benches before the mass the morph misses was lumped have no mass_scale: the feature is then 0.
+    const double mass = column.count("mass_scale") ? number(f[column["mass_scale"]]) : std::nan("");
+    if (std::isfinite(mass)) e.massScale = mass;
     Sample s;
     s.features = shapedb::core::errorFeatures(e);
     s.error = std::abs(number(f[column["f1_error"]]));

@@ -23,7 +23,8 @@ ErrorFeatures errorFeatures(const ErrorEvidence& e) {
           ln(e.maxMomentError, 1e-3),
           ln(e.descriptorDistance, 1e-2),
           e.outsideShare,
-          e.morphTargetDistance ? ln(*e.morphTargetDistance, 1e-3) : 0.0};
+          e.morphTargetDistance ? ln(*e.morphTargetDistance, 1e-3) : 0.0,
+          e.massScale && *e.massScale > 0.0 ? std::abs(std::log(*e.massScale)) : 0.0};
 }
 
 const ErrorModel& defaultErrorModel() {
@@ -34,8 +35,8 @@ const ErrorModel& defaultErrorModel() {
   // signs between splits). The corrected answer: mean and max deviation and the morph's remaining
   // distance.
   static const ErrorModel model = {
-      /*nearest=*/{1.36192, 1.4063, 0, 0, 0, 0, 0},
-      /*corrected=*/{0.816174, 0.71731, 0.7854, 0, 0, 0, 0.197589},
+      /*nearest=*/{1.36192, 1.4063, 0, 0, 0, 0, 0, 0},
+      /*corrected=*/{0.816174, 0.71731, 0.7854, 0, 0, 0, 0.197589, 0},
   };
   return model;
 }

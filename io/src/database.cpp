@@ -467,7 +467,10 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       core::ErrorEvidence evidence = core::evidenceOf(*out.answeredMatch().fidelity);
       evidence.outsideShare =
           static_cast<double>(out.link.outsideCount) / static_cast<double>(mesh.vertices.size());
-      if (out.correction) evidence.morphTargetDistance = out.correction->morph.meanTargetDistance;
+      if (out.correction) {
+        evidence.morphTargetDistance = out.correction->morph.meanTargetDistance;
+        evidence.massScale = out.correction->massScale;
+      }
       out.predictedFrequencyError = core::predictFrequencyError(evidence);
     }
   }

@@ -298,7 +298,10 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
             if (!q.link.locations.empty())
               m.outsideShare =
                   static_cast<double>(q.link.outsideCount) / static_cast<double>(q.link.locations.size());
-            if (q.correction) m.morphTargetDistance = q.correction->morph.meanTargetDistance;
+            if (q.correction) {
+              m.morphTargetDistance = q.correction->morph.meanTargetDistance;
+              m.massScale = q.correction->massScale;
+            }
             if (q.predictedFrequencyError) m.predictedError = *q.predictedFrequencyError;
             m.matchMicros = q.times.validate + q.times.massProperties + q.times.describe + q.times.search;
             return m;
@@ -400,12 +403,12 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
   file << "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
           "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
           "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,"
-          "morph_target_distance,predicted_error,status\n";
+          "morph_target_distance,mass_scale,predicted_error,status\n";
   for (const FragmentEvaluation& e : evaluations) {
     const std::string head = csvField(e.name) + "," + std::to_string(e.triangles) + "," + number(e.volume) +
                              "," + std::to_string(e.truthTets) + "," + number(e.truthSeconds) + ",";
     if (e.methods.empty()) {
-      file << head << ",,,,,,,,,,,,,,,,,,,,,," << csvField(e.error) << "\n";
+      file << head << ",,,,,,,,,,,,,,,,,,,,,,," << csvField(e.error) << "\n";
       continue;
     }
     for (const MethodEvaluation& m : e.methods) {
@@ -421,8 +424,8 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
            << (descriptor ? number(e.truthSeconds * 1e6 / m.queryMicros) : std::string()) << ","
            << number(m.meanDeviation) << "," << number(m.maxDeviation) << "," << number(m.maxMomentError)
            << "," << number(m.descriptorDistance) << "," << number(m.outsideShare) << ","
-           << number(m.morphTargetDistance) << "," << number(m.predictedError) << ","
-           << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
+           << number(m.morphTargetDistance) << "," << number(m.massScale) << "," << number(m.predictedError)
+           << "," << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
     }
   }
   file.flush();

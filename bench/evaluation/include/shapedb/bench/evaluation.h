@@ -74,6 +74,7 @@ struct MethodEvaluation {
   /// The corrected query: how far the shape's surface stays from the morphed tets, on average (relative
   /// to L; volume::MorphReport::meanTargetDistance).
   double morphTargetDistance = kNaN;
+  double massScale = kNaN;       ///< the corrected query: volume::CorrectionReport::massScale
   double predictedError = kNaN;  ///< descriptors: the query's QueryResult::predictedFrequencyError
   double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link), fidelity
                               ///< report aside
