@@ -1,5 +1,7 @@
-// The supernodal Cholesky factorization (CHOLMOD) of the modal analysis, against Eigen's dense LLᵀ.
+// The sparse Cholesky factorization (CHOLMOD, supernodal or simplicial) of the modal analysis and the
+// morph, against Eigen's dense LLᵀ.
 
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -15,20 +17,38 @@
 namespace shapedb::volume::detail {
 namespace {
 
+constexpr std::array<CholeskyMethod, 3> kMethods{CholeskyMethod::kAuto, CholeskyMethod::kSimplicial,
+                                                 CholeskyMethod::kSupernodal};
+
+const char* name(CholeskyMethod method) {
+  switch (method) {
+    case CholeskyMethod::kAuto:
+      return "auto";
+    case CholeskyMethod::kSimplicial:
+      return "simplicial";
+    case CholeskyMethod::kSupernodal:
+      return "supernodal";
+  }
+  return "?";
+}
+
 /// A symmetric positive definite matrix with the structure of an FEM matrix: 3 × 3 blocks coupling the
-/// nodes of a grid of `side`³ nodes to their neighbours, random values, made definite by its diagonal.
-Eigen::SparseMatrix<double> gridMatrix(int side, std::mt19937_64& rng) {
+/// nodes of a grid of `side` × `side` × `length` nodes to their neighbours, random values, made definite by
+/// its diagonal.
+Eigen::SparseMatrix<double> gridMatrix(int side, std::mt19937_64& rng, int length = 0) {
   std::uniform_real_distribution<double> value(-1.0, 1.0);
+  if (length == 0) length = side;
+  const int nx = length;
   const auto node = [side](int x, int y, int z) { return (x * side + y) * side + z; };
   std::vector<Eigen::Triplet<double>> entries;
-  for (int x = 0; x < side; ++x)
+  for (int x = 0; x < nx; ++x)
     for (int y = 0; y < side; ++y)
       for (int z = 0; z < side; ++z)
         for (int dx = 0; dx <= 1; ++dx)
           for (int dy = -1; dy <= 1; ++dy)
             for (int dz = -1; dz <= 1; ++dz) {
               if (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0))) continue;  // each pair once
-              if (x + dx >= side || y + dy < 0 || y + dy >= side || z + dz < 0 || z + dz >= side) continue;
+              if (x + dx >= nx || y + dy < 0 || y + dy >= side || z + dz < 0 || z + dz >= side) continue;
               const int a = node(x, y, z), b = node(x + dx, y + dy, z + dz);
               for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j) {
@@ -39,7 +59,7 @@ Eigen::SparseMatrix<double> gridMatrix(int side, std::mt19937_64& rng) {
             }
   // Diagonally dominant: definite. (The diagonal goes in with the rest: inserting into a built sparse
   // matrix costs a pass over it per entry.)
-  const int n = 3 * side * side * side;
+  const int n = 3 * nx * side * side;
   std::vector<double> rowSum(static_cast<std::size_t>(n), 0.1);
   for (const Eigen::Triplet<double>& t : entries)
     rowSum[static_cast<std::size_t>(t.row())] += std::abs(t.value());
@@ -53,44 +73,65 @@ Eigen::SparseMatrix<double> gridMatrix(int side, std::mt19937_64& rng) {
 
 TEST(SparseCholesky, SolvesAsTheDenseCholeskyForRandomMatricesOrdersAndRightHandSides) {
   std::mt19937_64 rng(5);
-  for (int side : {2, 3, 5, 7}) {
-    const Eigen::SparseMatrix<double> a = gridMatrix(side, rng);
-    const Eigen::MatrixXd dense(a);
-    const Eigen::LLT<Eigen::MatrixXd> oracle(dense);
-    ASSERT_EQ(oracle.info(), Eigen::Success);
-    // CHOLMOD's own ordering, and a random one given to it.
-    std::vector<int> order(static_cast<std::size_t>(a.rows()));
-    std::iota(order.begin(), order.end(), 0);
-    std::shuffle(order.begin(), order.end(), rng);
-    for (const std::vector<int>& given : {std::vector<int>{}, order}) {
-      SparseCholesky cholesky;
-      ASSERT_TRUE(cholesky.factorize(a, given)) << "side " << side;
-      ASSERT_EQ(cholesky.rows(), a.rows());
-      for (Eigen::Index columns : {1, 7}) {
-        const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), columns);
-        const Eigen::MatrixXd x = cholesky.solve(b);
-        const Eigen::MatrixXd expected = oracle.solve(b);
-        EXPECT_LT((x - expected).norm(), 1e-10 * expected.norm())
-            << "side " << side << ", " << columns << " columns, " << (given.empty() ? "own" : "given")
-            << " order";
+  for (const CholeskyMethod method : kMethods)
+    for (int side : {2, 3, 5, 7}) {
+      const Eigen::SparseMatrix<double> a = gridMatrix(side, rng);
+      const Eigen::MatrixXd dense(a);
+      const Eigen::LLT<Eigen::MatrixXd> oracle(dense);
+      ASSERT_EQ(oracle.info(), Eigen::Success);
+      // CHOLMOD's own ordering, and a random one given to it.
+      std::vector<int> order(static_cast<std::size_t>(a.rows()));
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), rng);
+      for (const std::vector<int>& given : {std::vector<int>{}, order}) {
+        SparseCholesky cholesky(method);
+        ASSERT_TRUE(cholesky.factorize(a, given)) << "side " << side << ", " << name(method);
+        ASSERT_EQ(cholesky.rows(), a.rows());
+        for (Eigen::Index columns : {1, 7}) {
+          const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), columns);
+          const Eigen::MatrixXd x = cholesky.solve(b);
+          const Eigen::MatrixXd expected = oracle.solve(b);
+          EXPECT_LT((x - expected).norm(), 1e-10 * expected.norm())
+              << "side " << side << ", " << columns << " columns, " << (given.empty() ? "own" : "given")
+              << " order, " << name(method);
+        }
       }
     }
-  }
 }
 
 TEST(SparseCholesky, AnIndefiniteOrMalformedMatrixIsRefused) {
-  std::mt19937_64 rng(6);
-  Eigen::SparseMatrix<double> a = gridMatrix(3, rng);
-  a.coeffRef(10, 10) = -1e3;  // a negative pivot
-  SparseCholesky cholesky;
-  EXPECT_FALSE(cholesky.factorize(a));
-  EXPECT_EQ(cholesky.rows(), 0);
-  Eigen::SparseMatrix<double> rectangular(6, 3);
-  rectangular.makeCompressed();
-  EXPECT_FALSE(cholesky.factorize(rectangular));
-  const Eigen::SparseMatrix<double> b = gridMatrix(2, rng);
-  EXPECT_FALSE(cholesky.factorize(b, {0, 1, 2})) << "an order of the wrong size";
-  EXPECT_TRUE(cholesky.factorize(b)) << "the same object factorizes again";
+  for (const CholeskyMethod method : kMethods) {
+    SCOPED_TRACE(name(method));
+    std::mt19937_64 rng(6);
+    Eigen::SparseMatrix<double> a = gridMatrix(3, rng);
+    a.coeffRef(10, 10) = -1e3;  // a negative pivot
+    SparseCholesky cholesky(method);
+    EXPECT_FALSE(cholesky.factorize(a));
+    EXPECT_EQ(cholesky.rows(), 0);
+    Eigen::SparseMatrix<double> rectangular(6, 3);
+    rectangular.makeCompressed();
+    EXPECT_FALSE(cholesky.factorize(rectangular));
+    const Eigen::SparseMatrix<double> b = gridMatrix(2, rng);
+    EXPECT_FALSE(cholesky.factorize(b, {0, 1, 2})) << "an order of the wrong size";
+    EXPECT_TRUE(cholesky.factorize(b)) << "the same object factorizes again";
+  }
+}
+
+// kAuto: column by column where the factor stays sparse (a slender bar of nodes), by dense blocks where it
+// fills in (a cube of them); a forced method is the method used.
+TEST(SparseCholesky, TheAutomaticMethodFollowsTheFactorsDensity) {
+  std::mt19937_64 rng(8);
+  const Eigen::SparseMatrix<double> bar = gridMatrix(2, rng, 200), cube = gridMatrix(12, rng);
+  SparseCholesky automatic;
+  ASSERT_TRUE(automatic.factorize(bar));
+  EXPECT_FALSE(automatic.supernodal());
+  ASSERT_TRUE(automatic.factorize(cube, nodeBlockOrder(cube)));
+  EXPECT_TRUE(automatic.supernodal());
+  for (const CholeskyMethod method : {CholeskyMethod::kSimplicial, CholeskyMethod::kSupernodal}) {
+    SparseCholesky forced(method);
+    ASSERT_TRUE(forced.factorize(bar));
+    EXPECT_EQ(forced.supernodal(), method == CholeskyMethod::kSupernodal) << name(method);
+  }
 }
 
 // The database build factorizes on every worker thread at once, through whichever BLAS the system has:
@@ -107,7 +148,7 @@ TEST(SparseCholesky, ConcurrentFactorizationsAndSolvesEqualSerialOnes) {
   const auto solveAll = [&](int first, int step, std::vector<Eigen::MatrixXd>& out) {
     for (std::size_t i = static_cast<std::size_t>(first); i < matrices.size();
          i += static_cast<std::size_t>(step)) {
-      SparseCholesky cholesky;
+      SparseCholesky cholesky(CholeskyMethod::kSupernodal);
       out[i] = cholesky.factorize(matrices[i]) ? cholesky.solve(rhs[i]) : Eigen::MatrixXd();
     }
   };

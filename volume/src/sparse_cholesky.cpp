@@ -104,10 +104,24 @@ struct SparseCholesky::Impl {
   mutable cholmod_dense* y = nullptr;
   mutable cholmod_dense* e = nullptr;
 
-  Impl() {
+  explicit Impl(CholeskyMethod method) {
     cholmod_start(&common);
     common.print = 0;  // errors are returned to the caller, not printed
-    common.supernodal = CHOLMOD_SUPERNODAL;
+    // LLᵀ by either method, so that a matrix that is not positive definite is refused by both (a
+    // simplicial LDLᵀ would go on through an indefinite one).
+    common.final_ll = 1;
+    switch (method) {
+      case CholeskyMethod::kAuto:
+        common.supernodal = CHOLMOD_AUTO;
+        common.supernodal_switch = kSupernodalSwitch;
+        break;
+      case CholeskyMethod::kSimplicial:
+        common.supernodal = CHOLMOD_SIMPLICIAL;
+        break;
+      case CholeskyMethod::kSupernodal:
+        common.supernodal = CHOLMOD_SUPERNODAL;
+        break;
+    }
     common.quick_return_if_not_posdef = 1;
   }
   ~Impl() {
@@ -123,7 +137,7 @@ struct SparseCholesky::Impl {
   }
 };
 
-SparseCholesky::SparseCholesky() : mImpl(std::make_unique<Impl>()) {}
+SparseCholesky::SparseCholesky(CholeskyMethod method) : mImpl(std::make_unique<Impl>(method)) {}
 SparseCholesky::~SparseCholesky() = default;
 
 bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order) {
@@ -178,6 +192,10 @@ bool SparseCholesky::solve(const double* b, double* x, Eigen::Index columns) con
   }
   std::memcpy(x, s.x->x, sizeof(double) * rhs.nzmax);
   return true;
+}
+
+bool SparseCholesky::supernodal() const {
+  return mImpl->factor && mImpl->factor->is_super;
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {

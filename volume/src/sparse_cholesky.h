@@ -1,9 +1,12 @@
 #pragma once
-// A sparse Cholesky factorization A = L Lᵀ of a symmetric positive definite matrix by CHOLMOD's
-// supernodal method (SuiteSparse): the modal analysis's shift-invert factors K − σM once and solves with
-// it tens of times. Dense blocks of the factor go through BLAS, so the factorization of a quadratic-tet
-// stiffness matrix takes a half to a third of the time of a column-by-column (simplicial) one, and a solve
-// with many right-hand sides costs a few solves with one. Private to the volume module.
+// A sparse Cholesky factorization A = L Lᵀ of a symmetric positive definite matrix by CHOLMOD
+// (SuiteSparse): the modal analysis's shift-invert factors K − σM once and solves with it tens of times,
+// and the morph's registration factors one system per round. Two methods, chosen per matrix once its
+// ordering has been analysed: supernodal, where the factor's dense blocks go through BLAS (a half to a
+// third of the time of a column-by-column factorization for the compact, heavy entries: rings, shells,
+// stones), and simplicial, column by column, where the factor is sparse (slender entries, and every small
+// matrix) and the BLAS calls on small blocks would cost more than their arithmetic. Private to the volume
+// module.
 
 #include <memory>
 #include <vector>
@@ -19,9 +22,21 @@ namespace shapedb::volume::detail {
 /// (the node graph has a ninth of the entries). Precondition: rows() divisible by 3.
 std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix);
 
+/// How SparseCholesky factorizes: kAuto chooses by the factor's density, the others force a method (for
+/// tests and the factorization bench).
+enum class CholeskyMethod { kAuto, kSimplicial, kSupernodal };
+
+/// kAuto's threshold: supernodal where the factorization's flops per entry of the factor (CHOLMOD's fl /
+/// lnz, known after the analysis) reach this. Measured on the default catalog's quadratic entries with
+/// BLIS as the BLAS (bench/results/epyc-2core/factorization_2026-11-27.md): the simplicial method wins
+/// below ~150 (slender entries, the registration's linear systems: 1.5-6× faster), the supernodal above
+/// ~200 (compact ones, up to 2× faster); CHOLMOD's own default, 40, sends nearly all of them to the
+/// supernodal method.
+inline constexpr double kSupernodalSwitch = 175.0;
+
 class SparseCholesky {
  public:
-  SparseCholesky();
+  explicit SparseCholesky(CholeskyMethod method = CholeskyMethod::kAuto);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
@@ -39,6 +54,8 @@ class SparseCholesky {
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
 
   Eigen::Index rows() const { return mRows; }
+  /// Whether the last successful factorize was supernodal (else simplicial).
+  bool supernodal() const;
 
  private:
   struct Impl;
