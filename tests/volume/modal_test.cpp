@@ -72,6 +72,45 @@ TEST(Fem, QuadraticReferenceMassIsTheClosedForm) {
   EXPECT_NEAR(m.sum(), 1.0, 1e-14);
 }
 
+// The closed form against the product it replaces: Bᵀ D B (B the strain–displacement matrix in Voigt
+// order with engineering shears, D the isotropic elasticity) summed over the four-point rule, on random
+// tets and materials.
+TEST(Fem, QuadraticElementStiffnessIsTheVoigtProduct) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0), poisson(0.0, 0.49), modulus(0.1, 10.0);
+  const double a = 0.5854101966249685, b = 0.1381966011250105;
+  const std::array<Eigen::Vector4d, 4> points{Eigen::Vector4d(a, b, b, b), Eigen::Vector4d(b, a, b, b),
+                                              Eigen::Vector4d(b, b, a, b), Eigen::Vector4d(b, b, b, a)};
+  for (int trial = 0; trial < 50; ++trial) {
+    std::array<Vec3, 4> corners;
+    for (Vec3& p : corners)
+      p = Vec3(coordinate(rng), coordinate(rng), coordinate(rng));
+    const auto [grad, volume] = core::tetGradients(corners);
+    if (std::abs(volume) < 1e-3) continue;
+    const core::Material material{
+        .name = "test", .density = 1.0, .youngsModulus = modulus(rng), .poissonRatio = poisson(rng)};
+    const double e = material.youngsModulus, nu = material.poissonRatio;
+    const double lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = e / (2.0 * (1.0 + nu));
+    Eigen::Matrix<double, 6, 6> d = Eigen::Matrix<double, 6, 6>::Zero();
+    d.topLeftCorner<3, 3>().setConstant(lambda);
+    d.topLeftCorner<3, 3>().diagonal().array() += 2.0 * mu;
+    d.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
+    Eigen::Matrix<double, 30, 30> expected = Eigen::Matrix<double, 30, 30>::Zero();
+    for (const Eigen::Vector4d& l : points) {
+      const Eigen::Matrix<double, 3, 10> g = quadraticGradients(grad, l);
+      Eigen::Matrix<double, 6, 30> strain = Eigen::Matrix<double, 6, 30>::Zero();
+      for (int n = 0; n < 10; ++n) {
+        strain(0, 3 * n) = strain(4, 3 * n + 2) = strain(5, 3 * n + 1) = g(0, n);
+        strain(1, 3 * n + 1) = strain(3, 3 * n + 2) = strain(5, 3 * n) = g(1, n);
+        strain(2, 3 * n + 2) = strain(3, 3 * n + 1) = strain(4, 3 * n) = g(2, n);
+      }
+      expected += (std::abs(volume) / 4.0) * strain.transpose() * d * strain;
+    }
+    const Eigen::Matrix<double, 30, 30> ke = quadraticElementStiffness(grad, std::abs(volume), material);
+    EXPECT_LT((ke - expected).norm(), 1e-12 * expected.norm()) << "trial " << trial;
+  }
+}
+
 /// Displacements of every node of either mesh from a function of position.
 template <typename Field>
 Eigen::VectorXd interpolate(const std::vector<Vec3>& nodes, Field field) {

@@ -379,6 +379,30 @@ class Assembler {
 
 }  // namespace
 
+Eigen::Matrix<double, 30, 30> quadraticElementStiffness(
+    const Eigen::Matrix<double, 3, 4>& barycentricGradients, double volume, const core::Material& material) {
+  // T(3a + i, 3b + j) = Σ_q w ∂_i N_a ∂_j N_b over the quadrature points: W Wᵀ, W's columns the points'
+  // gradients stacked node by node (a 3 × 10 matrix's column-major storage), times √w each.
+  Eigen::Matrix<double, 30, 4> w;
+  const auto& points = quadraticQuadraturePoints();
+  for (std::size_t q = 0; q < points.size(); ++q) {
+    const Eigen::Matrix<double, 3, 10> g = quadraticGradients(barycentricGradients, points[q]);
+    w.col(static_cast<Eigen::Index>(q)) = Eigen::Map<const Eigen::Matrix<double, 30, 1>>(g.data());
+  }
+  Eigen::Matrix<double, 30, 30> t;
+  t.noalias() = (volume / 4.0) * w * w.transpose();
+  const double e = material.youngsModulus, nu = material.poissonRatio;
+  const double lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = e / (2.0 * (1.0 + nu));
+  Eigen::Matrix<double, 30, 30> ke;
+  for (int b = 0; b < 10; ++b)
+    for (int a = 0; a < 10; ++a) {
+      const Eigen::Matrix3d s = t.block<3, 3>(3 * a, 3 * b);
+      ke.block<3, 3>(3 * a, 3 * b) =
+          lambda * s + mu * s.transpose() + (mu * s.trace()) * Eigen::Matrix3d::Identity();
+    }
+  return ke;
+}
+
 FemMatrices assembleFem(const TetMesh& mesh, const core::Material& material) {
   const Eigen::Matrix<double, 6, 6> d = elasticity(material);
   // Consistent mass of a linear tet: ρV/20 · (1 + δ_ab) per axis.
@@ -395,16 +419,11 @@ FemMatrices assembleFem(const TetMesh& mesh, const core::Material& material) {
 }
 
 FemMatrices assembleFem(const QuadraticTetMesh& mesh, const core::Material& material) {
-  const Eigen::Matrix<double, 6, 6> d = elasticity(material);
   Assembler<10> assembler(mesh.nodeCount(), mesh.tets);
   for (const QuadraticTetMesh::Tet& tet : mesh.tets) {
     const auto [grad, volume] =
         core::tetGradients({mesh.nodes[tet[0]], mesh.nodes[tet[1]], mesh.nodes[tet[2]], mesh.nodes[tet[3]]});
-    Eigen::Matrix<double, 30, 30> ke = Eigen::Matrix<double, 30, 30>::Zero();
-    for (const Eigen::Vector4d& l : quadraticQuadraturePoints()) {
-      const Eigen::Matrix<double, 6, 30> b = strainDisplacement<10>(quadraticGradients(grad, l));
-      ke.noalias() += (volume / 4.0) * b.transpose() * d * b;
-    }
+    const Eigen::Matrix<double, 30, 30> ke = quadraticElementStiffness(grad, volume, material);
     const Eigen::Matrix<double, 10, 10> me = material.density * volume * quadraticReferenceMass();
     assembler.add(tet, ke, me);
   }

@@ -52,6 +52,14 @@ Eigen::Matrix<double, 3, 10> quadraticGradients(const Eigen::Matrix<double, 3, 4
 /// The reference scalar mass matrix of the 10-node tet: ∫ N_a N_b dV / V, exact.
 const Eigen::Matrix<double, 10, 10>& quadraticReferenceMass();
 
+/// The stiffness matrix of one 10-node tet of an isotropic `material` (30 × 30: x, y, z of each node in
+/// the node order of QuadraticTetMesh::Tet), by the four-point rule that is exact for it, from the
+/// gradients of the tet's barycentric coordinates and its volume (core::tetGradients). Per pair of nodes
+/// the closed form of Bᵀ D B, λ ∇N_a ∇N_bᵀ + μ ∇N_b ∇N_aᵀ + μ (∇N_a · ∇N_b) I, in a quarter of its
+/// arithmetic; tests compare it with the product.
+Eigen::Matrix<double, 30, 30> quadraticElementStiffness(
+    const Eigen::Matrix<double, 3, 4>& barycentricGradients, double volume, const core::Material& material);
+
 /// K and M of the quadratic tets (stiffness by the exact four-point rule, consistent mass exact).
 FemMatrices assembleFem(const QuadraticTetMesh& mesh, const core::Material& material = core::unitMaterial());
 
