@@ -295,8 +295,9 @@ Eigen::Matrix<double, 6, 3 * N> strainDisplacement(const Eigen::Matrix<double, 3
   return b;
 }
 
-/// Assembles element matrices straight into the compressed storage of K and M: the pattern first (3 × 3
-/// blocks per pair of nodes that share an element), then each element's values added where they belong.
+/// Assembles element matrices straight into the compressed storage of K and M: the patterns first (a 3 × 3
+/// block of K per pair of nodes that share an element, and its diagonal in M), then each element's values
+/// added where they belong.
 /// 2–3× faster than Eigen's triplets for quadratic tets, which bring 900 + 300 of them each.
 template <std::size_t N>
 class Assembler {
@@ -321,26 +322,34 @@ class Assembler {
     }
     for (std::size_t i = 0; i < nodeCount; ++i)
       mStart[i + 1] += mStart[i];
-    // Column 3b + c of the 3n × 3n matrix: rows 3a, 3a + 1, 3a + 2 for every neighbour a of b.
+    // K's column 3b + c: rows 3a, 3a + 1, 3a + 2 for every neighbour a of b. M's 3 × 3 blocks are
+    // diagonal (the same scalar mass on each axis): its column 3b + c has row 3a + c only.
     const auto n = static_cast<Eigen::Index>(3 * nodeCount);
-    for (Eigen::SparseMatrix<double>* m : {&mMatrices.stiffness, &mMatrices.mass}) {
-      m->resize(n, n);
-      m->resizeNonZeros(static_cast<Eigen::Index>(9 * pairs.size()));
-      int* outer = m->outerIndexPtr();
-      int* inner = m->innerIndexPtr();
-      for (std::size_t b = 0; b < nodeCount; ++b) {
-        const std::size_t degree = mStart[b + 1] - mStart[b];
-        for (std::size_t c = 0; c < 3; ++c) {
-          const std::size_t column = 3 * b + c, first = 9 * mStart[b] + 3 * degree * c;
-          outer[column] = static_cast<int>(first);
-          for (std::size_t k = 0; k < degree; ++k)
-            for (std::size_t r = 0; r < 3; ++r)
-              inner[first + 3 * k + r] = static_cast<int>(3 * mNeighbours[mStart[b] + k] + r);
+    Eigen::SparseMatrix<double>& k = mMatrices.stiffness;
+    Eigen::SparseMatrix<double>& m = mMatrices.mass;
+    k.resize(n, n);
+    k.resizeNonZeros(static_cast<Eigen::Index>(9 * pairs.size()));
+    m.resize(n, n);
+    m.resizeNonZeros(static_cast<Eigen::Index>(3 * pairs.size()));
+    for (std::size_t b = 0; b < nodeCount; ++b) {
+      const std::size_t degree = mStart[b + 1] - mStart[b];
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::size_t column = 3 * b + c, first = 9 * mStart[b] + 3 * degree * c,
+                          firstMass = 3 * mStart[b] + degree * c;
+        k.outerIndexPtr()[column] = static_cast<int>(first);
+        m.outerIndexPtr()[column] = static_cast<int>(firstMass);
+        for (std::size_t j = 0; j < degree; ++j) {
+          const std::uint32_t a = mNeighbours[mStart[b] + j];
+          for (std::size_t r = 0; r < 3; ++r)
+            k.innerIndexPtr()[first + 3 * j + r] = static_cast<int>(3 * a + r);
+          m.innerIndexPtr()[firstMass + j] = static_cast<int>(3 * a + c);
         }
       }
-      outer[n] = static_cast<int>(9 * pairs.size());
-      std::fill_n(m->valuePtr(), 9 * pairs.size(), 0.0);
     }
+    k.outerIndexPtr()[n] = static_cast<int>(9 * pairs.size());
+    m.outerIndexPtr()[n] = static_cast<int>(3 * pairs.size());
+    std::fill_n(k.valuePtr(), 9 * pairs.size(), 0.0);
+    std::fill_n(m.valuePtr(), 3 * pairs.size(), 0.0);
   }
 
   /// Adds an element's stiffness (3N × 3N) and its scalar mass (N × N, on each axis).
@@ -355,21 +364,18 @@ class Assembler {
       const std::size_t degree = mStart[b + 1] - mStart[b];
       for (std::size_t i = 0; i < N; ++i) {
         const auto slot = static_cast<std::size_t>(std::lower_bound(begin, end, e[i]) - begin);
+        const double mass = scalarMass(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
         for (std::size_t c = 0; c < 3; ++c) {
           const std::size_t at = 9 * mStart[b] + 3 * degree * c + 3 * slot;
           for (std::size_t r = 0; r < 3; ++r)
             k[at + r] += ke(static_cast<Eigen::Index>(3 * i + r), static_cast<Eigen::Index>(3 * j + c));
-          m[at + c] += scalarMass(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+          m[3 * mStart[b] + degree * c + slot] += mass;
         }
       }
     }
   }
 
-  /// K and M; M without the zeros of the pattern (the 3 × 3 blocks of the mass are diagonal).
-  FemMatrices finish() && {
-    mMatrices.mass.prune(0.0);
-    return std::move(mMatrices);
-  }
+  FemMatrices finish() && { return std::move(mMatrices); }
 
  private:
   std::vector<std::size_t> mStart;
