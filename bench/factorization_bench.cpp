@@ -108,9 +108,8 @@ int main(int argc, char** argv) {
     return v.empty() ? 0.0 : v[v.size() / 2];
   };
   std::printf(
-      "\nmedian speedup of the automatic choice over the supernodal method alone: factor %.2fx, factor and "
-      "64 "
-      "solves %.2fx\n",
+      "\nmedian speedup of the automatic choice over the supernodal method alone: factor %.2fx, "
+      "factor and 64 solves %.2fx\n",
       median(factorRatio), median(blockRatio));
   return 0;
 }

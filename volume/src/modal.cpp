@@ -27,19 +27,12 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 SparseMatrix shiftedStiffness(const SparseMatrix& k, const SparseMatrix& m, double sigma) {
   SparseMatrix out = k;
   out.makeCompressed();
-  const SparseMatrix* mass = &m;
-  SparseMatrix compressedMass;
-  if (!m.isCompressed()) {
-    compressedMass = m;
-    compressedMass.makeCompressed();
-    mass = &compressedMass;
-  }
   double* values = out.valuePtr();
   const int* rows = out.innerIndexPtr();
   for (Eigen::Index column = 0; column < out.outerSize(); ++column) {
     int at = out.outerIndexPtr()[column];
     const int end = out.outerIndexPtr()[column + 1];
-    for (SparseMatrix::InnerIterator it(*mass, column); it; ++it) {
+    for (SparseMatrix::InnerIterator it(m, column); it; ++it) {
       while (at < end && rows[at] < it.row())
         ++at;
       if (at == end || rows[at] != it.row()) {
@@ -297,11 +290,19 @@ const std::array<Eigen::Vector4d, 4>& quadraticQuadraturePoints() {
   return points;
 }
 
+/// Lamé's parameters of an isotropic material.
+struct Lame {
+  double lambda = 0.0, mu = 0.0;
+};
+Lame lame(const core::Material& material) {
+  const double e = material.youngsModulus, nu = material.poissonRatio;
+  return {e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu))};
+}
+
 /// Isotropic elasticity in Voigt order (xx, yy, zz, yz, xz, xy) with engineering shear strains.
 Eigen::Matrix<double, 6, 6> elasticity(const core::Material& material) {
-  const double e = material.youngsModulus, nu = material.poissonRatio;
+  const auto [lambda, mu] = lame(material);
   Eigen::Matrix<double, 6, 6> d = Eigen::Matrix<double, 6, 6>::Zero();
-  const double lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = e / (2.0 * (1.0 + nu));
   d.topLeftCorner<3, 3>().setConstant(lambda);
   d.topLeftCorner<3, 3>().diagonal().array() += 2.0 * mu;
   d.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
@@ -426,8 +427,8 @@ class Assembler {
 
 Eigen::Matrix<double, 30, 30> quadraticElementStiffness(
     const Eigen::Matrix<double, 3, 4>& barycentricGradients, double volume, const core::Material& material) {
-  // T(3a + i, 3b + j) = Σ_q w ∂_i N_a ∂_j N_b over the quadrature points: W Wᵀ, W's columns the points'
-  // gradients stacked node by node (a 3 × 10 matrix's column-major storage), times √w each.
+  // T(3a + i, 3b + j) = Σ_q w ∂_i N_a ∂_j N_b over the quadrature points, all of weight w = V/4: w W Wᵀ,
+  // W's columns the points' gradients stacked node by node (a 3 × 10 matrix's column-major storage).
   Eigen::Matrix<double, 30, 4> w;
   const auto& points = quadraticQuadraturePoints();
   for (std::size_t q = 0; q < points.size(); ++q) {
@@ -436,8 +437,7 @@ Eigen::Matrix<double, 30, 30> quadraticElementStiffness(
   }
   Eigen::Matrix<double, 30, 30> t;
   t.noalias() = (volume / 4.0) * w * w.transpose();
-  const double e = material.youngsModulus, nu = material.poissonRatio;
-  const double lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = e / (2.0 * (1.0 + nu));
+  const auto [lambda, mu] = lame(material);
   Eigen::Matrix<double, 30, 30> ke;
   for (int b = 0; b < 10; ++b)
     for (int a = 0; a < 10; ++a) {
