@@ -2,7 +2,9 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
+#include <utility>
 
 #include <shapedb/core/spatial.h>
 
@@ -332,6 +334,62 @@ TetLocation TetLocator::locate(const Vec3& p, Hint* hint) const {
   }
   if (bestMin >= -kInsideTolerance) return best;
   return outside(p, hint);
+}
+
+SurfaceSide::SurfaceSide(const TriangleMesh& surface)
+    : mTree(surface),
+      mTriangles(surface.triangles),
+      mFaceNormals(surface.triangles.size(), Vec3::Zero()),
+      mEdgeNormals(surface.triangles.size()),
+      mVertexNormals(surface.vertices.size(), Vec3::Zero()) {
+  // An edge's pseudonormal is the sum of its two faces' normals: keyed by its corners, smaller first.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, Vec3> edges;
+  const auto key = [](std::uint32_t a, std::uint32_t b) { return std::pair(std::min(a, b), std::max(a, b)); };
+  for (std::size_t t = 0; t < mTriangles.size(); ++t) {
+    const TriangleMesh::Triangle& tri = mTriangles[t];
+    const Vec3 n = (surface.vertices[tri[1]] - surface.vertices[tri[0]])
+                       .cross(surface.vertices[tri[2]] - surface.vertices[tri[0]]);
+    if (n.norm() > 0.0) mFaceNormals[t] = n.normalized();
+    for (std::size_t k = 0; k < 3; ++k) {
+      edges.try_emplace(key(tri[k], tri[(k + 1) % 3]), Vec3::Zero()).first->second += mFaceNormals[t];
+      const Vec3 u = surface.vertices[tri[(k + 1) % 3]] - surface.vertices[tri[k]];
+      const Vec3 v = surface.vertices[tri[(k + 2) % 3]] - surface.vertices[tri[k]];
+      const double angle = std::atan2(u.cross(v).norm(), u.dot(v));
+      mVertexNormals[tri[k]] += angle * mFaceNormals[t];
+    }
+  }
+  for (std::size_t t = 0; t < mTriangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      mEdgeNormals[t][k] = edges.at(key(mTriangles[t][k], mTriangles[t][(k + 1) % 3]));
+}
+
+double SurfaceSide::signedDistance(const Vec3& p) const {
+  const ClosestPointTree::Hit hit = mTree.closest(p);
+  // closestPointOnTriangle gives exact zeros outside the face's own Voronoi region: one zero, an edge;
+  // two, a corner.
+  const std::array<double, 3>& b = hit.closest.barycentric;
+  const int zeros = (b[0] == 0.0) + (b[1] == 0.0) + (b[2] == 0.0);
+  Vec3 normal = mFaceNormals[hit.triangle];
+  if (zeros == 2) {
+    const std::size_t corner = b[0] != 0.0 ? 0 : b[1] != 0.0 ? 1 : 2;
+    normal = mVertexNormals[mTriangles[hit.triangle][corner]];
+  } else if (zeros == 1) {
+    const std::size_t opposite = b[0] == 0.0 ? 0 : b[1] == 0.0 ? 1 : 2;  // the edge from opposite + 1
+    normal = mEdgeNormals[hit.triangle][(opposite + 1) % 3];
+  }
+  const double distance = std::sqrt(hit.closest.squaredDistance);
+  return (p - hit.closest.point).dot(normal) < 0.0 ? -distance : distance;
+}
+
+double windingNumber(const TriangleMesh& surface, const Vec3& p) {
+  // Van Oosterom & Strackee's solid angle of each triangle seen from p.
+  double sum = 0.0;
+  for (const TriangleMesh::Triangle& t : surface.triangles) {
+    const Vec3 a = surface.vertices[t[0]] - p, b = surface.vertices[t[1]] - p, c = surface.vertices[t[2]] - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    sum += 2.0 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+  }
+  return sum / (4.0 * std::numbers::pi);
 }
 
 TetLocation locateBruteForce(const TetLocator& locator, const Vec3& p) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <random>
 
@@ -69,6 +70,76 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleWhereFloatBoxesAreCoarse) {
     p *= 1e39;  // beyond float's largest, 3.4e38
   SCOPED_TRACE("beyond float's range");
   expectAgreesWithEveryTriangle(huge, rng, 1.5);
+}
+
+// A torus of `rings` × `segments` quads, each split in two: closed, genus one, wound outward, with
+// saddles where no convex shape has them.
+TriangleMesh makeTorus(double major, double minor, int rings, int segments) {
+  TriangleMesh m;
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const double u = 2.0 * std::numbers::pi * i / rings, v = 2.0 * std::numbers::pi * j / segments;
+      m.vertices.emplace_back((major + minor * std::cos(v)) * std::cos(u),
+                              (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
+    }
+  const auto at = [&](int i, int j) {
+    return static_cast<std::uint32_t>(((i + rings) % rings) * segments + (j + segments) % segments);
+  };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return m;
+}
+
+// SurfaceSide against the winding number: points spread over the surface's box, and points just off the
+// surface beside its vertices and edges, where the closest point is a corner or on an edge and only the
+// pseudonormals there tell the side.
+void expectSidesAgreeWithWindingNumber(const TriangleMesh& surface, std::mt19937_64& rng) {
+  const SurfaceSide side(surface);
+  const ClosestPointTree tree(surface);
+  const Bounds b = computeBounds(surface);
+  std::uniform_real_distribution<double> u(-0.25, 1.25), jitter(-1.0, 1.0);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 1500; ++i)
+    points.push_back(b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent()));
+  const double near = 1e-3 * b.extent().norm();
+  for (int i = 0; i < 1500; ++i) {
+    const auto& t = surface.triangles[rng() % surface.triangles.size()];
+    const Vec3 corner = surface.vertices[t[rng() % 3]],
+               edge = 0.5 * (surface.vertices[t[0]] + surface.vertices[t[1]]);
+    points.push_back((i % 2 ? corner : edge) + near * Vec3(jitter(rng), jitter(rng), jitter(rng)));
+  }
+  int insides = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double winding = windingNumber(surface, points[i]);
+    ASSERT_LT(std::min(std::abs(winding), std::abs(winding - 1.0)), 1e-6) << "point " << i;
+    ASSERT_EQ(side.inside(points[i]), winding > 0.5) << "point " << i << ", winding " << winding;
+    ASSERT_NEAR(std::abs(side.signedDistance(points[i])),
+                std::sqrt(tree.closest(points[i]).closest.squaredDistance), 1e-12);
+    insides += winding > 0.5;
+  }
+  // Both sides were tried, near the surface as well as far from it.
+  EXPECT_GT(insides, 600);
+  EXPECT_LT(insides, 2400);
+}
+
+TEST(SurfaceSide, AgreesWithTheWindingNumber) {
+  std::mt19937_64 rng(9);
+  {
+    SCOPED_TRACE("torus");
+    expectSidesAgreeWithWindingNumber(makeTorus(1.0, 0.35, 24, 12), rng);
+  }
+  {
+    SCOPED_TRACE("ellipsoid");
+    expectSidesAgreeWithWindingNumber(
+        transformed(makeUvEllipsoid({1.0, 0.6, 0.3}, 24, 12), test::randomSimilarity(rng)), rng);
+  }
+  {
+    SCOPED_TRACE("box");
+    expectSidesAgreeWithWindingNumber(makeBox({1.0, 2.0, 0.5}), rng);
+  }
 }
 
 TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {

@@ -65,6 +65,32 @@ class ClosestPointTree {
   std::vector<Node> mNodes;
 };
 
+/// Which side of a closed, consistently oriented surface a point lies on: the sign of (p − q) · n, q the
+/// surface's closest point to p and n the angle-weighted pseudonormal of the face, edge or vertex that q
+/// lies on (Bærentzen & Aanæs 2005), which is right wherever the closest point is, edges and corners
+/// included. A ClosestPointTree search a point. Immutable once built: concurrent queries are safe.
+class SurfaceSide {
+ public:
+  SurfaceSide() = default;
+  /// Precondition: the surface is closed and its triangles wound outward (analyzeTopology); a triangle
+  /// of zero area counts for no side.
+  explicit SurfaceSide(const TriangleMesh& closedSurface);
+  /// The distance from p to the surface, negative inside.
+  double signedDistance(const Vec3& p) const;
+  bool inside(const Vec3& p) const { return signedDistance(p) < 0.0; }
+
+ private:
+  ClosestPointTree mTree;
+  std::vector<TriangleMesh::Triangle> mTriangles;
+  std::vector<Vec3> mFaceNormals;                 ///< unit, per triangle (0 for one of zero area)
+  std::vector<std::array<Vec3, 3>> mEdgeNormals;  ///< per triangle, edge k from corner k to k + 1
+  std::vector<Vec3> mVertexNormals;               ///< Σ corner angle × face normal
+};
+
+/// The oracle of SurfaceSide: the generalized winding number of a closed surface about p (Jacobson et
+/// al. 2013), the sum of its triangles' solid angles over 4π: 1 inside, 0 outside. Every triangle.
+double windingNumber(const TriangleMesh& surface, const Vec3& p);
+
 /// Where a point lies in a tet mesh: the tet that contains it and its barycentric weights, or, outside
 /// the mesh, the tet owning the closest boundary face and the weights of that closest point. Either way
 /// the four weights are ≥ 0 (to round-off) and sum to 1.
