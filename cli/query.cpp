@@ -111,6 +111,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mean_target_distance", c.morph.meanTargetDistance},
           {"projected", c.morph.projected},
           {"mass_scale", c.massScale},
+          {"stray_share", c.strayShare},
           {"morphs", c.morphs},
           {"solves", c.solves},
           {"morph_seconds", c.morphSeconds},

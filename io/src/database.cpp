@@ -419,6 +419,12 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
         out.correction = c.corrected->report;
         corrected = std::move(c.corrected);
         correctedLocator = std::make_shared<const core::TetLocator>(corrected->physics.tetMesh);
+        if (out.correction->strayShare > volume::kStrayShareWarning)
+          correctionWarning =
+              "geometry correction: " + std::to_string(std::lround(100 * out.correction->strayShare)) +
+              " % of the morphed tets lie outside the mesh (the entry spans a gap the object "
+              "has, as between limbs or through a loop): the corrected frequencies may be far "
+              "off; the object's own data (enrichment) are the answer for it";
       } else {
         correctionWarning = "geometry correction not applied (the entry's own data stand): " + c.error;
       }

@@ -72,27 +72,6 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleWhereFloatBoxesAreCoarse) {
   expectAgreesWithEveryTriangle(huge, rng, 1.5);
 }
 
-// A torus of `rings` × `segments` quads, each split in two: closed, genus one, wound outward, with
-// saddles where no convex shape has them.
-TriangleMesh makeTorus(double major, double minor, int rings, int segments) {
-  TriangleMesh m;
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      const double u = 2.0 * std::numbers::pi * i / rings, v = 2.0 * std::numbers::pi * j / segments;
-      m.vertices.emplace_back((major + minor * std::cos(v)) * std::cos(u),
-                              (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
-    }
-  const auto at = [&](int i, int j) {
-    return static_cast<std::uint32_t>(((i + rings) % rings) * segments + (j + segments) % segments);
-  };
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return m;
-}
-
 // SurfaceSide against the winding number: points spread over the surface's box, and points just off the
 // surface beside its vertices and edges, where the closest point is a corner or on an edge and only the
 // pseudonormals there tell the side.
@@ -129,7 +108,7 @@ TEST(SurfaceSide, AgreesWithTheWindingNumber) {
   std::mt19937_64 rng(9);
   {
     SCOPED_TRACE("torus");
-    expectSidesAgreeWithWindingNumber(makeTorus(1.0, 0.35, 24, 12), rng);
+    expectSidesAgreeWithWindingNumber(test::makeTorus(1.0, 0.35, 24, 12), rng);
   }
   {
     SCOPED_TRACE("ellipsoid");

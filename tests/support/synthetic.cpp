@@ -10,6 +10,25 @@
 
 namespace shapedb::test {
 
+core::TriangleMesh makeTorus(double major, double minor, int rings, int segments) {
+  core::TriangleMesh m;
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const double u = 2.0 * std::numbers::pi * i / rings, v = 2.0 * std::numbers::pi * j / segments;
+      m.vertices.emplace_back((major + minor * std::cos(v)) * std::cos(u),
+                              (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
+    }
+  const auto at = [&](int i, int j) {
+    return static_cast<std::uint32_t>(((i + rings) % rings) * segments + (j + segments) % segments);
+  };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return m;
+}
+
 core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions) {
   core::TriangleMesh mesh = core::makeIcosphere(1.0, subdivisions);
   // Tapers make it pear-shaped along x and along y; the bump breaks every remaining symmetry.

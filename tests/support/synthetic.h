@@ -15,6 +15,11 @@ namespace shapedb::test {
 /// along x and y (pear-shaped), bumped, and stretched by `radii`. No symmetry at all.
 core::TriangleMesh makeLopsidedBlob(const core::Vec3& radii, int subdivisions);
 
+/// A torus about z, `major` from its axis to the tube's centre, the tube `minor` in radius, `rings` ×
+/// `segments` quads each split in two: closed, genus one, wound outward, with saddles where no convex
+/// shape has them.
+core::TriangleMesh makeTorus(double major, double minor, int rings, int segments);
+
 /// A random closed, outward-oriented shape: a star-shaped bumpy blob (icosphere with a random radial
 /// wave, stretched by random radii), a box, an ellipsoid or a cylinder of random proportions.
 /// Deterministic for a given generator state.

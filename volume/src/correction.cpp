@@ -40,6 +40,21 @@ std::vector<double> missingMass(const core::TetMesh& tets, const core::TriangleM
   return share;
 }
 
+// CorrectionReport::strayShare: the volume of the tets whose centroid lies outside `target`, over all
+// of theirs.
+double strayShare(const core::TetMesh& tets, const core::TriangleMesh& target) {
+  const core::SurfaceSide side(target);
+  double outside = 0.0, total = 0.0;
+  for (std::size_t t = 0; t < tets.tetCount(); ++t) {
+    const core::Vec3 centroid = 0.25 * (tets.nodes[tets.tets[t][0]] + tets.nodes[tets.tets[t][1]] +
+                                        tets.nodes[tets.tets[t][2]] + tets.nodes[tets.tets[t][3]]);
+    const double volume = std::abs(core::tetVolume(tets, t));
+    total += volume;
+    if (!side.inside(centroid)) outside += volume;
+  }
+  return total > 0.0 ? outside / total : 0.0;
+}
+
 }  // namespace
 
 Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::TriangleMesh& target,
@@ -68,6 +83,7 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::Tri
     if (targetMass->volume > volume)
       out.pointMasses = missingMass(out.tetMesh, target, targetMass->volume - volume);
   }
+  out.report.strayShare = strayShare(out.tetMesh, target);
   out.report.morphSeconds = secondsSince(start);
   return out;
 }

@@ -23,6 +23,12 @@ struct CorrectionReport {
   /// where boundary nodes held back cut its edges and corners, or left out a part the entry has no tets
   /// for. The modes carry the target's whole mass all the same (MorphedEntry::pointMasses).
   double massScale = 1.0;
+  /// The share of the morphed tets' volume that lies outside the target's surface (each tet by its
+  /// centroid): material the morph carried across a gap the target has (between a figure's legs,
+  /// through a knot's loop, over a cup's mouth), which ties apart what the target holds apart and
+  /// stiffens the corrected modes. About 0 where the morph follows the target; on real objects a tenth
+  /// or more marked the corrected answers that were tens of per cent off (docs/architecture.md).
+  double strayShare = 0.0;
   int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
   /// Entries morphed to choose this one from (a query's candidates, io::QueryOptions::correctionCandidates);
   /// morphSeconds is all of their morphs'.
@@ -30,6 +36,12 @@ struct CorrectionReport {
   double morphSeconds = 0.0;
   double modesSeconds = 0.0;
 };
+
+/// A stray share (CorrectionReport::strayShare) above which a query warns that its corrected data are
+/// unreliable: on the twelve real meshes of the benchmarks, the six corrected answers past it were 12-690 %
+/// off in their first frequency; of the five under 1 %, four were within 5 % (the fifth, a tray its morph
+/// held a third of, 43 % off: massScale tells that one).
+inline constexpr double kStrayShareWarning = 0.1;
 
 /// The corrected entry: PhysicalData in the entry's canonical frame as a database entry's (so that
 /// core::adapt carries it to the query like any entry: the target's mass, unit Young's modulus), with the

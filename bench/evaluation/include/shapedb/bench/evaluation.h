@@ -75,6 +75,7 @@ struct MethodEvaluation {
   /// to L; volume::MorphReport::meanTargetDistance).
   double morphTargetDistance = kNaN;
   double massScale = kNaN;       ///< the corrected query: volume::CorrectionReport::massScale
+  double strayShare = kNaN;      ///< the corrected query: volume::CorrectionReport::strayShare
   double predictedError = kNaN;  ///< descriptors: the query's QueryResult::predictedFrequencyError
   double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link), fidelity
                               ///< report aside
