@@ -108,6 +108,9 @@ std::vector<Sample> readSamples(const std::string& path, const std::string& meth
     // Benches before the mass the morph misses was lumped have no mass_scale: the feature is then 0.
     const double mass = column.count("mass_scale") ? number(f[column["mass_scale"]]) : std::nan("");
     if (std::isfinite(mass)) e.massScale = mass;
+    // Nor before the morphed tets outside the shape were measured: stray_share.
+    const double stray = column.count("stray_share") ? number(f[column["stray_share"]]) : std::nan("");
+    if (std::isfinite(stray)) e.strayShare = stray;
     Sample s;
     s.features = shapedb::core::errorFeatures(e);
     s.error = std::abs(number(f[column["f1_error"]]));

@@ -476,6 +476,7 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       if (out.correction) {
         evidence.morphTargetDistance = out.correction->morph.meanTargetDistance;
         evidence.massScale = out.correction->massScale;
+        evidence.strayShare = out.correction->strayShare;
       }
       out.predictedFrequencyError = core::predictFrequencyError(evidence);
     }

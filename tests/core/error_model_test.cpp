@@ -26,6 +26,7 @@ TEST(ErrorModel, FeaturesAreTheLogarithmsOfTheEvidence) {
   EXPECT_EQ(f[5], 0.25);
   EXPECT_EQ(f[6], 0.0);  // not corrected
   EXPECT_EQ(f[7], 0.0);
+  EXPECT_EQ(f[8], 0.0);
   e.morphTargetDistance = 0.004;
   EXPECT_DOUBLE_EQ(errorFeatures(e)[6], std::log(0.005));
   // The mass the morph misses counts the same as the mass it holds too much of: |ln massScale|.
@@ -33,6 +34,8 @@ TEST(ErrorModel, FeaturesAreTheLogarithmsOfTheEvidence) {
   EXPECT_DOUBLE_EQ(errorFeatures(e)[7], std::log(2.0));
   e.massScale = 0.5;
   EXPECT_DOUBLE_EQ(errorFeatures(e)[7], std::log(2.0));
+  e.strayShare = 0.2;
+  EXPECT_EQ(errorFeatures(e)[8], 0.2);
   // Evidence of a perfect match stays finite.
   for (double x : errorFeatures(ErrorEvidence{}))
     EXPECT_TRUE(std::isfinite(x));
@@ -40,8 +43,8 @@ TEST(ErrorModel, FeaturesAreTheLogarithmsOfTheEvidence) {
 
 TEST(ErrorModel, ThePredictionIsTheExponentialOfTheWeightedFeaturesOfItsKind) {
   ErrorModel model;
-  model.nearest = {std::log(0.05), 1.0, 0, 0, 0, 0, 0, 0};
-  model.corrected = {std::log(0.02), 0, 0, 0, 0, 0, 0.5, 2.0};
+  model.nearest = {std::log(0.05), 1.0, 0, 0, 0, 0, 0, 0, 0};
+  model.corrected = {std::log(0.02), 0, 0, 0, 0, 0, 0.5, 2.0, 3.0};
   ErrorEvidence e;
   e.meanDeviation = 0.099;  // ln(0.1)
   EXPECT_NEAR(predictFrequencyError(e, model), 0.05 * 0.1, 1e-15);
@@ -49,6 +52,8 @@ TEST(ErrorModel, ThePredictionIsTheExponentialOfTheWeightedFeaturesOfItsKind) {
   EXPECT_NEAR(predictFrequencyError(e, model), 0.02 * std::sqrt(0.004), 1e-15);
   e.massScale = 1.5;  // and |ln 1.5| · 2
   EXPECT_NEAR(predictFrequencyError(e, model), 0.02 * std::sqrt(0.004) * 1.5 * 1.5, 1e-15);
+  e.strayShare = 0.1;  // and 0.1 · 3
+  EXPECT_NEAR(predictFrequencyError(e, model), 0.02 * std::sqrt(0.004) * 1.5 * 1.5 * std::exp(0.3), 1e-15);
 }
 
 TEST(ErrorModel, TheShippedModelGrowsWithTheSurfaceDeviationOfACorrectedAnswer) {

@@ -243,6 +243,7 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
         f.descriptorDistance,
         static_cast<double>(r->link.outsideCount) / static_cast<double>(query.vertexCount()),
         std::nullopt,
+        std::nullopt,
         std::nullopt};
     EXPECT_DOUBLE_EQ(*r->predictedFrequencyError, core::predictFrequencyError(evidence)) << e.name;
     const bool sampled = turnsSampled(*surface);

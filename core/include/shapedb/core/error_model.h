@@ -21,6 +21,9 @@ struct ErrorEvidence {
   /// tets'. Far from 1, much of the query's mass is lumped where the tets do not reach (or the tets hold
   /// more than the query), and the answer is less sure.
   std::optional<double> massScale;
+  /// Corrected answers only: volume::CorrectionReport::strayShare, the share of the morphed tets' volume
+  /// outside the query's surface (material across a gap the query has).
+  std::optional<double> strayShare;
 };
 
 struct Fidelity;
@@ -28,13 +31,13 @@ struct Fidelity;
 /// The evidence of a fidelity report alone (no link, not corrected).
 ErrorEvidence evidenceOf(const Fidelity& fidelity);
 
-inline constexpr int kErrorFeatures = 8;
+inline constexpr int kErrorFeatures = 9;
 using ErrorFeatures = std::array<double, kErrorFeatures>;
 
 /// The model's features: 1, ln(meanDeviation + 1e-3), ln(maxDeviation + 1e-3), ln(maxMomentError +
-/// 1e-3), ln(descriptorDistance + 1e-2), outsideShare, ln(morphTargetDistance + 1e-3) and |ln massScale|
-/// (each 0 when not known). Logarithms: the errors span three decades and grow with the evidence's own
-/// scale.
+/// 1e-3), ln(descriptorDistance + 1e-2), outsideShare, ln(morphTargetDistance + 1e-3), |ln massScale| and
+/// strayShare (each 0 when not known). Logarithms: the errors span three decades and grow with the evidence's
+/// own scale.
 ErrorFeatures errorFeatures(const ErrorEvidence& evidence);
 
 /// Weights of the features for the nearest entry's answer and the corrected one: ln|error| ≈ w · f.
