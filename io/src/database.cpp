@@ -53,7 +53,8 @@ struct Correction {
 
 /// Morphs the entries of `q`'s first `candidates` matches (`entries`, in match order) onto `mesh`, each
 /// carried into its entry's canonical frame, and computes the modes of the morph that reaches `mesh`'s
-/// surface best (the smallest mean target distance; the first of equals). Candidates whose morph fails
+/// surface best (the smallest mean target distance; the first of equals) among those whose tets do not
+/// stray across a gap of it (volume::kStrayShareWarning), if any do not. Candidates whose morph fails
 /// are passed over.
 Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryResult& q,
                                   std::span<const std::shared_ptr<const CachedEntry>> entries,
@@ -79,7 +80,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
       continue;
     }
     morphSeconds += morphed->report.morphSeconds;
-    if (!chosen || morphed->report.morph.meanTargetDistance < chosen->report.morph.meanTargetDistance) {
+    if (!chosen || volume::betterMorph(morphed->report, chosen->report)) {
       chosen = std::move(morphed).value();
       out.answered = i;
     }

@@ -142,6 +142,23 @@ TEST(Correction, TheTetsTheMorphCarriesAcrossAGapAreStray) {
   EXPECT_GT(morphed->report.strayShare, 0.05);
 }
 
+// Which candidate's morph the modes are computed on: the one nearer the target's surface, unless its tets
+// stray across a gap of the target and the other's do not.
+TEST(Correction, TheBetterMorphReachesTheTargetWithoutStrayingAcrossItsGaps) {
+  CorrectionReport near, far;
+  near.morph.meanTargetDistance = 0.01;
+  far.morph.meanTargetDistance = 0.03;
+  EXPECT_TRUE(betterMorph(near, far));
+  EXPECT_FALSE(betterMorph(far, near));
+  EXPECT_FALSE(betterMorph(near, near));
+  near.strayShare = 0.25;  // across a gap: the farther one that keeps to the target wins
+  far.strayShare = kStrayShareWarning;
+  EXPECT_TRUE(betterMorph(far, near));
+  EXPECT_FALSE(betterMorph(near, far));
+  far.strayShare = 0.3;  // both stray: by distance again
+  EXPECT_TRUE(betterMorph(near, far));
+}
+
 // The mass the morph misses: an ellipsoid's tets onto a box cut the box's edges and corners. The tets keep
 // their shape; the box's volume they lack is lumped at their boundary nodes, all of it (the answer has the
 // box's mass), none inside, and most of it at the nodes nearest the box's corners and edges, where it is

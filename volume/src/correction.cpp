@@ -88,6 +88,12 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::Tri
   return out;
 }
 
+bool betterMorph(const CorrectionReport& a, const CorrectionReport& b) {
+  const bool aStrays = a.strayShare > kStrayShareWarning, bStrays = b.strayShare > kStrayShareWarning;
+  if (aStrays != bStrays) return bStrays;
+  return a.morph.meanTargetDistance < b.morph.meanTargetDistance;
+}
+
 Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEntry morphed,
                                       const ModalOptions& modal) {
   CorrectedEntry out;

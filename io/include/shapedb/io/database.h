@@ -57,7 +57,8 @@ struct QueryOptions {
   volume::CorrectionOptions correction;
   /// With correct: the entries of the first this many matches (the search finds at least as many) are
   /// each morphed onto the query, and the one whose morphed tets reach the query's surface best (the
-  /// smallest mean distance from the query's vertices to them) is the one whose modes are computed and
+  /// smallest mean distance from the query's vertices to them; a morph whose tets stray across a gap of
+  /// the query, volume::kStrayShareWarning, only if all do) is the one whose modes are computed and
   /// given: the nearest descriptor is not always the shape that morphs best. Each further candidate costs
   /// one morph, a fraction of the modes' cost. On the benchmark, three took the median first-frequency
   /// error on real meshes from 24 % to 17 % and on fracture fragments from 5.9 % to 5.3 % and 3.7 % to

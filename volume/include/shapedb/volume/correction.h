@@ -43,6 +43,13 @@ struct CorrectionReport {
 /// held a third of, 43 % off: massScale tells that one).
 inline constexpr double kStrayShareWarning = 0.1;
 
+/// Whether morph `a` is a better one to compute the modes on than `b` (a query's candidates,
+/// io::QueryOptions::correctionCandidates): one whose tets do not stray across a gap of the target
+/// (strayShare ≤ kStrayShareWarning) before one whose do, whatever their distances; then the one that
+/// reaches the target's surface best (the smaller morph.meanTargetDistance). Neither is better than an
+/// equal.
+bool betterMorph(const CorrectionReport& a, const CorrectionReport& b);
+
 /// The corrected entry: PhysicalData in the entry's canonical frame as a database entry's (so that
 /// core::adapt carries it to the query like any entry: the target's mass, unit Young's modulus), with the
 /// morphed tets, the modes computed on them with the mass they lack lumped at their boundary
