@@ -337,30 +337,25 @@ TetLocation TetLocator::locate(const Vec3& p, Hint* hint) const {
 }
 
 SurfaceSide::SurfaceSide(const TriangleMesh& surface)
-    : mTree(surface),
-      mTriangles(surface.triangles),
-      mFaceNormals(surface.triangles.size(), Vec3::Zero()),
-      mEdgeNormals(surface.triangles.size()),
-      mVertexNormals(surface.vertices.size(), Vec3::Zero()) {
-  // An edge's pseudonormal is the sum of its two faces' normals: keyed by its corners, smaller first.
-  std::map<std::pair<std::uint32_t, std::uint32_t>, Vec3> edges;
-  const auto key = [](std::uint32_t a, std::uint32_t b) { return std::pair(std::min(a, b), std::max(a, b)); };
-  for (std::size_t t = 0; t < mTriangles.size(); ++t) {
-    const TriangleMesh::Triangle& tri = mTriangles[t];
-    const Vec3 n = (surface.vertices[tri[1]] - surface.vertices[tri[0]])
-                       .cross(surface.vertices[tri[2]] - surface.vertices[tri[0]]);
-    if (n.norm() > 0.0) mFaceNormals[t] = n.normalized();
-    for (std::size_t k = 0; k < 3; ++k) {
-      edges.try_emplace(key(tri[k], tri[(k + 1) % 3]), Vec3::Zero()).first->second += mFaceNormals[t];
-      const Vec3 u = surface.vertices[tri[(k + 1) % 3]] - surface.vertices[tri[k]];
-      const Vec3 v = surface.vertices[tri[(k + 2) % 3]] - surface.vertices[tri[k]];
-      const double angle = std::atan2(u.cross(v).norm(), u.dot(v));
-      mVertexNormals[tri[k]] += angle * mFaceNormals[t];
-    }
-  }
-  for (std::size_t t = 0; t < mTriangles.size(); ++t)
-    for (std::size_t k = 0; k < 3; ++k)
-      mEdgeNormals[t][k] = edges.at(key(mTriangles[t][k], mTriangles[t][(k + 1) % 3]));
+    : mTree(surface), mSurface(surface), mFirst(surface.vertices.size() + 1, 0) {
+  // The triangles around each vertex, by counting.
+  for (const TriangleMesh::Triangle& t : surface.triangles)
+    for (const std::uint32_t v : t)
+      ++mFirst[v + 1];
+  std::partial_sum(mFirst.begin(), mFirst.end(), mFirst.begin());
+  mIncident.resize(mFirst.back());
+  std::vector<std::uint32_t> next(mFirst.begin(), mFirst.end() - 1);
+  for (std::uint32_t t = 0; t < surface.triangles.size(); ++t)
+    for (const std::uint32_t v : surface.triangles[t])
+      mIncident[next[v]++] = t;
+}
+
+Vec3 SurfaceSide::faceNormal(std::uint32_t triangle) const {
+  const TriangleMesh::Triangle& t = mSurface.triangles[triangle];
+  const Vec3 n = (mSurface.vertices[t[1]] - mSurface.vertices[t[0]])
+                     .cross(mSurface.vertices[t[2]] - mSurface.vertices[t[0]]);
+  const double length = n.norm();
+  return length > 0.0 ? Vec3(n / length) : Vec3::Zero();
 }
 
 double SurfaceSide::signedDistance(const Vec3& p) const {
@@ -368,14 +363,29 @@ double SurfaceSide::signedDistance(const Vec3& p) const {
   // closestPointOnTriangle gives exact zeros outside the face's own Voronoi region: one zero, an edge;
   // two, a corner.
   const std::array<double, 3>& b = hit.closest.barycentric;
+  const TriangleMesh::Triangle& tri = mSurface.triangles[hit.triangle];
   const int zeros = (b[0] == 0.0) + (b[1] == 0.0) + (b[2] == 0.0);
-  Vec3 normal = mFaceNormals[hit.triangle];
+  Vec3 normal = Vec3::Zero();
   if (zeros == 2) {
-    const std::size_t corner = b[0] != 0.0 ? 0 : b[1] != 0.0 ? 1 : 2;
-    normal = mVertexNormals[mTriangles[hit.triangle][corner]];
+    // A corner: every triangle around it, weighted by its angle there.
+    const std::uint32_t v = tri[b[0] != 0.0 ? 0 : b[1] != 0.0 ? 1 : 2];
+    for (std::uint32_t i = mFirst[v]; i < mFirst[v + 1]; ++i) {
+      const TriangleMesh::Triangle& t = mSurface.triangles[mIncident[i]];
+      const std::size_t k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      const Vec3 u = mSurface.vertices[t[(k + 1) % 3]] - mSurface.vertices[v];
+      const Vec3 w = mSurface.vertices[t[(k + 2) % 3]] - mSurface.vertices[v];
+      normal += std::atan2(u.cross(w).norm(), u.dot(w)) * faceNormal(mIncident[i]);
+    }
   } else if (zeros == 1) {
-    const std::size_t opposite = b[0] == 0.0 ? 0 : b[1] == 0.0 ? 1 : 2;  // the edge from opposite + 1
-    normal = mEdgeNormals[hit.triangle][(opposite + 1) % 3];
+    // An edge: the triangles on both sides of it (those around one end that hold the other).
+    const std::size_t opposite = b[0] == 0.0 ? 0 : b[1] == 0.0 ? 1 : 2;
+    const std::uint32_t from = tri[(opposite + 1) % 3], to = tri[(opposite + 2) % 3];
+    for (std::uint32_t i = mFirst[from]; i < mFirst[from + 1]; ++i) {
+      const TriangleMesh::Triangle& t = mSurface.triangles[mIncident[i]];
+      if (t[0] == to || t[1] == to || t[2] == to) normal += faceNormal(mIncident[i]);
+    }
+  } else {
+    normal = faceNormal(hit.triangle);
   }
   const double distance = std::sqrt(hit.closest.squaredDistance);
   return (p - hit.closest.point).dot(normal) < 0.0 ? -distance : distance;

@@ -68,7 +68,9 @@ class ClosestPointTree {
 /// Which side of a closed, consistently oriented surface a point lies on: the sign of (p − q) · n, q the
 /// surface's closest point to p and n the angle-weighted pseudonormal of the face, edge or vertex that q
 /// lies on (Bærentzen & Aanæs 2005), which is right wherever the closest point is, edges and corners
-/// included. A ClosestPointTree search a point. Immutable once built: concurrent queries are safe.
+/// included. A ClosestPointTree search a point; the pseudonormal of the edge or corner found is made then,
+/// from the triangles around it, so that building one costs the tree and a pass over the triangles.
+/// Immutable once built: concurrent queries are safe.
 class SurfaceSide {
  public:
   SurfaceSide() = default;
@@ -80,11 +82,11 @@ class SurfaceSide {
   bool inside(const Vec3& p) const { return signedDistance(p) < 0.0; }
 
  private:
+  Vec3 faceNormal(std::uint32_t triangle) const;  ///< unit; 0 for a triangle of zero area
   ClosestPointTree mTree;
-  std::vector<TriangleMesh::Triangle> mTriangles;
-  std::vector<Vec3> mFaceNormals;                 ///< unit, per triangle (0 for one of zero area)
-  std::vector<std::array<Vec3, 3>> mEdgeNormals;  ///< per triangle, edge k from corner k to k + 1
-  std::vector<Vec3> mVertexNormals;               ///< Σ corner angle × face normal
+  TriangleMesh mSurface;
+  std::vector<std::uint32_t> mFirst;     ///< per vertex, where its triangles start in mIncident
+  std::vector<std::uint32_t> mIncident;  ///< the triangles around each vertex, vertex by vertex
 };
 
 /// The oracle of SurfaceSide: the generalized winding number of a closed surface about p (Jacobson et
