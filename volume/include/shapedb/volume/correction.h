@@ -27,7 +27,8 @@ struct CorrectionReport {
   /// centroid): material the morph carried across a gap the target has (between a figure's legs,
   /// through a knot's loop, over a cup's mouth), which ties apart what the target holds apart and
   /// stiffens the corrected modes. About 0 where the morph follows the target; on real objects a tenth
-  /// or more went with corrected answers 12-690 % off (docs/architecture.md).
+  /// or more went with corrected answers 12-690 % off (docs/architecture.md). 0, unknown, where the
+  /// target bounds no solid (an open surface has no inside).
   double strayShare = 0.0;
   int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
   /// Entries morphed to choose this one from (a query's candidates, io::QueryOptions::correctionCandidates);
