@@ -83,9 +83,9 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::Tri
     if (targetMass->volume > volume)
       out.pointMasses = missingMass(out.tetMesh, target, targetMass->volume - volume);
   }
-  // A side is defined only for a surface that bounds a solid (a closed one, the precondition of
-  // SurfaceSide): for any other the share stays 0, unknown.
-  if (targetMass && !targetMass->isApproximate) out.report.strayShare = strayShare(out.tetMesh, target);
+  // A side is defined only for a surface that bounds a solid (closed and oriented, the precondition of
+  // SurfaceSide, which computeMassProperties checks): for any other the share stays 0, unknown.
+  if (targetMass) out.report.strayShare = strayShare(out.tetMesh, target);
   out.report.morphSeconds = secondsSince(start);
   return out;
 }
