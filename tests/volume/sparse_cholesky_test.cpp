@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -95,6 +96,40 @@ TEST(SparseCholesky, SolvesAsTheDenseCholeskyForRandomMatricesOrdersAndRightHand
               << "side " << side << ", " << columns << " columns, " << (given.empty() ? "own" : "given")
               << " order, " << name(method);
         }
+      }
+    }
+}
+
+TEST(SparseCholesky, TheFactorsHalvesComposeTheInverse) {
+  // A⁻¹ = H Hᵀ with H = solveFactorTransposed and Hᵀ = solveFactor, taken column by column of the
+  // identity: what the modal analysis's symmetric shift-invert rests on. Hᵀ A H = I says the same
+  // without the oracle.
+  std::mt19937_64 rng(7);
+  for (const CholeskyMethod method : kMethods)
+    for (int side : {2, 3, 5}) {
+      const Eigen::SparseMatrix<double> a = gridMatrix(side, rng);
+      const Eigen::MatrixXd dense(a);
+      const Eigen::MatrixXd inverse = dense.llt().solve(Eigen::MatrixXd::Identity(a.rows(), a.rows()));
+      std::vector<int> order(static_cast<std::size_t>(a.rows()));
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), rng);
+      for (const std::vector<int>& given : {std::vector<int>{}, order}) {
+        SparseCholesky cholesky(method);
+        ASSERT_TRUE(cholesky.factorize(a, given)) << "side " << side << ", " << name(method);
+        const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(a.rows(), a.rows());
+        Eigen::MatrixXd h(a.rows(), a.rows()), ht(a.rows(), a.rows());
+        ASSERT_TRUE(cholesky.solveFactorTransposed(identity.data(), h.data(), a.rows()));
+        ASSERT_TRUE(cholesky.solveFactor(identity.data(), ht.data(), a.rows()));
+        const std::string what = "side " + std::to_string(side) + ", " + (given.empty() ? "own" : "given") +
+                                 " order, " + name(method);
+        EXPECT_LT((ht - h.transpose()).norm(), 1e-12 * h.norm()) << what;
+        EXPECT_LT((h * h.transpose() - inverse).norm(), 1e-10 * inverse.norm()) << what;
+        EXPECT_LT((h.transpose() * dense * h - identity).norm(), 1e-10 * identity.norm()) << what;
+        // One column at a time gives the same as all at once.
+        const Eigen::VectorXd b = Eigen::VectorXd::Random(a.rows());
+        Eigen::VectorXd x(a.rows());
+        ASSERT_TRUE(cholesky.solveFactor(b.data(), x.data()));
+        EXPECT_LT((x - ht * b).norm(), 1e-12 * x.norm()) << what;
       }
     }
 }

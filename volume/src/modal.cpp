@@ -6,8 +6,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
-#include <Spectra/MatOp/SparseSymMatProd.h>
-#include <Spectra/SymGEigsShiftSolver.h>
+#include <Spectra/SymEigsSolver.h>
 
 #include <shapedb/volume/modal.h>
 
@@ -46,35 +45,70 @@ SparseMatrix shiftedStiffness(const SparseMatrix& k, const SparseMatrix& m, doub
   return out;
 }
 
-/// y = P (K − σM)⁻¹ x for Spectra's shift-invert mode, by a supernodal sparse Cholesky factorization of
-/// K − σM (symmetric positive definite for σ < 0: K is semi-definite and M definite; Spectra's own
-/// SymShiftInvert uses sparse LU, about twice the work). P = I − R Rᵀ M removes the rigid motions R
-/// (M-orthonormal): Lanczos then never meets the six-fold eigenvalue of the rigid modes, which it can resolve
-/// short of one (it did, on a 3,500-node beam), and spends no iterations on them.
-class ShiftInvertLdlt {
+/// The shift-invert operator in symmetric form. With K − σM factorized (sparse Cholesky; σ < 0, so it is
+/// positive definite: K is semi-definite and M definite) as A = H⁻ᵀ H⁻¹ (SparseCholesky's halves), the
+/// pencil K φ = λ M φ becomes the standard symmetric problem C y = μ y, C = Hᵀ M H, with φ = H y and
+/// μ = 1 / (λ − σ): the smallest λ are the largest μ. Lanczos on C works in the Euclidean inner product;
+/// on the pencil itself (Spectra's SymGEigsShiftSolver) every step took four to six products with M for
+/// its M inner products and reorthogonalization, which cost more than the solve on quadratic tets. Here
+/// a step is one solve (its two halves) and one product with M. Q = I − Y Yᵀ removes the rigid motions,
+/// Y an orthonormal basis of their images H⁻¹ R = Hᵀ A R: Lanczos then never meets the six-fold
+/// eigenvalue of the rigid modes, which it can resolve short of one (it did, on a 3,500-node beam), and
+/// spends no iterations on them.
+class SymmetricShiftInvert {
  public:
   using Scalar = double;
-  ShiftInvertLdlt(const SparseMatrix& k, const SparseMatrix& m, const Eigen::MatrixXd& rigid)
-      : mK(k), mM(m), mRigid(rigid), mMRigid(m * rigid) {}
-  Eigen::Index rows() const { return mK.rows(); }
-  Eigen::Index cols() const { return mK.cols(); }
-  void set_shift(double sigma) {  // NOLINT: Spectra's interface
-    const SparseMatrix shifted = shiftedStiffness(mK, mM, sigma);
-    mOk = mSolver.factorize(shifted, detail::nodeBlockOrder(shifted));
-  }
-  void perform_op(const double* in, double* out) const {  // NOLINT: Spectra's interface
-    mSolver.solve(in, out);                               // NaN if it failed: Lanczos then fails, and says so
-    Eigen::Map<Eigen::VectorXd> y(out, mK.rows());
-    y.noalias() -= mRigid * (mMRigid.transpose() * y);
+  SymmetricShiftInvert(const SparseMatrix& k, const SparseMatrix& m, const Eigen::MatrixXd& rigid,
+                       double sigma)
+      : mM(m), mShifted(shiftedStiffness(k, m, sigma)), mScratch(k.rows()), mProduct(k.rows()) {
+    mOk = mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
+    if (!mOk) return;
+    // Orthonormal by Householder QR: the images are orthogonal already (Rᵀ A R = −σ I, as K R = 0), up to
+    // round-off.
+    const Eigen::MatrixXd images = imageOf(rigid);
+    mRigid = Eigen::HouseholderQR<Eigen::MatrixXd>(images).householderQ() *
+             Eigen::MatrixXd::Identity(images.rows(), images.cols());
   }
   bool ok() const { return mOk; }
+  Eigen::Index rows() const { return mM.rows(); }
+  Eigen::Index cols() const { return mM.cols(); }
+
+  void perform_op(const double* in, double* out) const {  // NOLINT: Spectra's interface
+    // NaN if a solve failed: Lanczos then fails, and says so.
+    mSolver.solveFactorTransposed(in, mScratch.data());
+    mProduct.noalias() = mM * mScratch;
+    mSolver.solveFactor(mProduct.data(), out);
+    Eigen::Map<Eigen::VectorXd> y(out, rows());
+    y.noalias() -= mRigid * (mRigid.transpose() * y);
+  }
+
+  /// y = H⁻¹ x = Hᵀ A x for vectors x of the pencil's space, the rigid motions removed.
+  Eigen::MatrixXd fromPencil(const Eigen::MatrixXd& x) const {
+    Eigen::MatrixXd y = imageOf(x);
+    y -= mRigid * (mRigid.transpose() * y);
+    return y;
+  }
+  /// φ = H y: the pencil's vectors of C's.
+  Eigen::MatrixXd toPencil(const Eigen::MatrixXd& y) const {
+    Eigen::MatrixXd x(y.rows(), y.cols());
+    mSolver.solveFactorTransposed(y.data(), x.data(), y.cols());
+    return x;
+  }
 
  private:
-  const SparseMatrix& mK;
+  /// H⁻¹ x = Hᵀ A x.
+  Eigen::MatrixXd imageOf(const Eigen::MatrixXd& x) const {
+    const Eigen::MatrixXd ax = mShifted * x;
+    Eigen::MatrixXd y(x.rows(), x.cols());
+    mSolver.solveFactor(ax.data(), y.data(), x.cols());
+    return y;
+  }
+
   const SparseMatrix& mM;
-  const Eigen::MatrixXd& mRigid;
-  const Eigen::MatrixXd mMRigid;
+  const SparseMatrix mShifted;  // A = K − σM
   detail::SparseCholesky mSolver;
+  Eigen::MatrixXd mRigid;
+  mutable Eigen::VectorXd mScratch, mProduct;
   bool mOk = false;
 };
 
@@ -495,27 +529,26 @@ Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMat
   // smaller |σ|, the better they separate, down to where K − σM becomes ill-conditioned.
   const double scale = fem.stiffness.diagonal().sum() / fem.mass.diagonal().sum();
   const double sigma = -1e-6 * scale;
-  ShiftInvertLdlt op(fem.stiffness, fem.mass, rigid);
-  Spectra::SparseSymMatProd<double> bop(fem.mass);
-  const Eigen::Index nev = options.modes;
-  const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
-  Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
-                               Spectra::GEigsMode::ShiftInvert>
-      eigs(op, bop, nev, ncv, sigma);
+  SymmetricShiftInvert op(fem.stiffness, fem.mass, rigid, sigma);
   if (!op.ok())
     return Error{ErrorCode::kParse, "the stiffness matrix could not be factorized (degenerate tets?)"};
+  const Eigen::Index nev = options.modes;
+  const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
+  Spectra::SymEigsSolver<SymmetricShiftInvert> eigs(op, nev, ncv);
   if (start) {
     // Lanczos keeps to the deflated space only if it starts there.
-    Eigen::VectorXd deflated = *start - rigid * ((fem.mass * rigid).transpose() * *start);
+    const Eigen::VectorXd deflated = op.fromPencil(*start);
     eigs.init(deflated.data());
   } else {
     eigs.init();
   }
-  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
+  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-10, Spectra::SortRule::LargestAlge);
   if (solves) *solves = static_cast<int>(eigs.num_operations());
   if (eigs.info() != Spectra::CompInfo::Successful)
     return Error{ErrorCode::kParse, "Lanczos did not converge on " + std::to_string(nev) + " modes"};
-  return makeModalData(eigs.eigenvalues(), eigs.eigenvectors(), rigidEigenvalues, fem, options);
+  // μ descending is λ = σ + 1/μ ascending.
+  const Eigen::VectorXd eigenvalues = sigma + eigs.eigenvalues().array().inverse();
+  return makeModalData(eigenvalues, op.toPencil(eigs.eigenvectors()), rigidEigenvalues, fem, options);
 }
 
 /// The seeds at every node of `mesh`: the corners' values as given, a mid-edge node's the mean of its

@@ -84,7 +84,8 @@ struct ModalOptions {
 };
 
 /// The first `modes` non-rigid modes of the free body, K φ = λ M φ, by shift-invert Lanczos (Spectra)
-/// around a small negative shift, K − σM factorized once by sparse Cholesky (LDLᵀ). The six smallest
+/// around a small negative shift, K − σM factorized once by sparse Cholesky (L Lᵀ), Lanczos run on the
+/// symmetric L⁻¹ M L⁻ᵀ. The six smallest
 /// eigenvalues must be the rigid modes (≈ 0 against the first elastic one); they are checked and
 /// dropped. Mode shapes are M-orthonormal (quadratic order: over all ten nodes of each tet, before the
 /// mid-edge values are dropped). Errors: kInvalidArgument (options, too few nodes), kParse when
