@@ -72,6 +72,14 @@ Eigen::SparseMatrix<double> gridMatrix(int side, std::mt19937_64& rng, int lengt
   return m;
 }
 
+/// A random elimination order of n rows.
+std::vector<int> shuffledOrder(Eigen::Index n, std::mt19937_64& rng) {
+  std::vector<int> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  return order;
+}
+
 TEST(SparseCholesky, SolvesAsTheDenseCholeskyForRandomMatricesOrdersAndRightHandSides) {
   std::mt19937_64 rng(5);
   for (const CholeskyMethod method : kMethods)
@@ -81,9 +89,7 @@ TEST(SparseCholesky, SolvesAsTheDenseCholeskyForRandomMatricesOrdersAndRightHand
       const Eigen::LLT<Eigen::MatrixXd> oracle(dense);
       ASSERT_EQ(oracle.info(), Eigen::Success);
       // CHOLMOD's own ordering, and a random one given to it.
-      std::vector<int> order(static_cast<std::size_t>(a.rows()));
-      std::iota(order.begin(), order.end(), 0);
-      std::shuffle(order.begin(), order.end(), rng);
+      const std::vector<int> order = shuffledOrder(a.rows(), rng);
       for (const std::vector<int>& given : {std::vector<int>{}, order}) {
         SparseCholesky cholesky(method);
         ASSERT_TRUE(cholesky.factorize(a, given)) << "side " << side << ", " << name(method);
@@ -110,9 +116,7 @@ TEST(SparseCholesky, TheFactorsHalvesComposeTheInverse) {
       const Eigen::SparseMatrix<double> a = gridMatrix(side, rng);
       const Eigen::MatrixXd dense(a);
       const Eigen::MatrixXd inverse = dense.llt().solve(Eigen::MatrixXd::Identity(a.rows(), a.rows()));
-      std::vector<int> order(static_cast<std::size_t>(a.rows()));
-      std::iota(order.begin(), order.end(), 0);
-      std::shuffle(order.begin(), order.end(), rng);
+      const std::vector<int> order = shuffledOrder(a.rows(), rng);
       for (const std::vector<int>& given : {std::vector<int>{}, order}) {
         SparseCholesky cholesky(method);
         ASSERT_TRUE(cholesky.factorize(a, given)) << "side " << side << ", " << name(method);
