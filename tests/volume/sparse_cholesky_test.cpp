@@ -138,6 +138,31 @@ TEST(SparseCholesky, TheFactorsHalvesComposeTheInverse) {
     }
 }
 
+TEST(SparseCholesky, ARefactorizationSolvesAsAFreshOne) {
+  // Matrices of one pattern and new values, factorized again on the first one's analysis, solve as the
+  // dense Cholesky of each; one that is not positive definite is refused, and leaves nothing to
+  // refactorize.
+  std::mt19937_64 rng(11);
+  for (const CholeskyMethod method : kMethods)
+    for (int side : {3, 6}) {
+      SparseCholesky cholesky(method);
+      ASSERT_FALSE(cholesky.refactorize(gridMatrix(side, rng))) << "nothing analysed yet";
+      ASSERT_TRUE(cholesky.factorize(gridMatrix(side, rng), shuffledOrder(3 * side * side * side, rng)));
+      for (int values = 0; values < 3; ++values) {
+        const Eigen::SparseMatrix<double> a = gridMatrix(side, rng);
+        ASSERT_TRUE(cholesky.refactorize(a)) << "side " << side << ", " << name(method);
+        const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), 3);
+        const Eigen::MatrixXd expected = Eigen::MatrixXd(a).llt().solve(b);
+        EXPECT_LT((cholesky.solve(b) - expected).norm(), 1e-10 * expected.norm())
+            << "side " << side << ", values " << values << ", " << name(method);
+      }
+      Eigen::SparseMatrix<double> indefinite = gridMatrix(side, rng);
+      indefinite.coeffRef(4, 4) = -1e3;
+      EXPECT_FALSE(cholesky.refactorize(indefinite)) << name(method);
+      EXPECT_FALSE(cholesky.refactorize(gridMatrix(side, rng))) << "the failed factor is gone";
+    }
+}
+
 TEST(SparseCholesky, AnIndefiniteOrMalformedMatrixIsRefused) {
   for (const CholeskyMethod method : kMethods) {
     SCOPED_TRACE(name(method));

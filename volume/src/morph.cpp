@@ -112,7 +112,7 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
     stiffnessScale += k.coeff(i, i);
   for (double a : nodeArea)
     fitScale += 3.0 * a;
-  // CHOLMOD's supernodal factor, in a node-block order worked out once: K's sparsity holds the fit's.
+  // CHOLMOD's factor, in a node-block order worked out once: K's sparsity holds the fit's.
   detail::SparseCholesky solver;
   const std::vector<int> order = detail::nodeBlockOrder(k);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
@@ -166,7 +166,8 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
                w * vertexArea[v] * static_cast<double>(stride));
     }
     if (!inPattern) break;  // cannot be: two nodes of a boundary face share its tet
-    if (!solver.factorize(a, order)) break;
+    // Every round's A has K's sparsity: the first round's analysis serves them all.
+    if (!(round == 0 ? solver.factorize(a, order) : solver.refactorize(a))) break;
     // The fit terms hold the start configuration's rigid motions, so the system is definite.
     Eigen::VectorXd next(n);
     if (!solver.solve(rhs.data(), next.data())) break;

@@ -141,13 +141,10 @@ struct SparseCholesky::Impl {
 SparseCholesky::SparseCholesky(CholeskyMethod method) : mImpl(std::make_unique<Impl>(method)) {}
 SparseCholesky::~SparseCholesky() = default;
 
-bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order) {
-  Impl& s = *mImpl;
-  s.freeFactor();
-  mRows = 0;
-  if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return false;
-  if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return false;
-  // A view of the matrix: CHOLMOD reads it, and with stype −1 only its lower triangle.
+namespace {
+
+/// A view of `matrix` for CHOLMOD, which reads it, and with stype −1 only its lower triangle.
+cholmod_sparse viewOf(const Eigen::SparseMatrix<double>& matrix) {
   cholmod_sparse a{};
   a.nrow = a.ncol = static_cast<std::size_t>(matrix.rows());
   a.nzmax = static_cast<std::size_t>(matrix.nonZeros());
@@ -160,6 +157,18 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   a.dtype = CHOLMOD_DOUBLE;
   a.sorted = 1;
   a.packed = 1;
+  return a;
+}
+
+}  // namespace
+
+bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order) {
+  Impl& s = *mImpl;
+  s.freeFactor();
+  mRows = 0;
+  if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return false;
+  if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return false;
+  cholmod_sparse a = viewOf(matrix);
   s.common.nmethods = 1;
   s.common.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
   s.common.postorder = 1;
@@ -167,12 +176,25 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   s.factor =
       cholmod_analyze_p(&a, order.empty() ? nullptr : const_cast<int*>(order.data()), nullptr, 0, &s.common);
   if (!s.factor) return false;
+  mRows = matrix.rows();
+  return factorizeNumerically(matrix);
+}
+
+bool SparseCholesky::refactorize(const Eigen::SparseMatrix<double>& matrix) {
+  const CallGuard guard;
+  return factorizeNumerically(matrix);
+}
+
+bool SparseCholesky::factorizeNumerically(const Eigen::SparseMatrix<double>& matrix) {
+  Impl& s = *mImpl;
+  if (!s.factor || matrix.rows() != mRows || matrix.cols() != mRows || !matrix.isCompressed()) return false;
+  cholmod_sparse a = viewOf(matrix);
   if (!cholmod_factorize(&a, s.factor, &s.common) || s.common.status != CHOLMOD_OK ||
       s.factor->minor < s.factor->n) {
     s.freeFactor();
+    mRows = 0;
     return false;
   }
-  mRows = matrix.rows();
   return true;
 }
 

@@ -46,6 +46,11 @@ class SparseCholesky {
   /// approximate minimum degree when empty). False when it is not positive definite or the factorization
   /// fails (then solve must not be called).
   bool factorize(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order = {});
+  /// Factorizes `matrix` again on the last factorize's symbolic analysis (its order, its method): for
+  /// matrices of one sparsity pattern and changing values, such as the morph's registration rounds.
+  /// Precondition: `matrix` has the sparsity pattern of the matrix last factorized. False, as factorize,
+  /// when it is not positive definite, and when there is no factor to start from.
+  bool refactorize(const Eigen::SparseMatrix<double>& matrix);
 
   /// X = A⁻¹ B, for any number of columns of B (several at once share each pass over the factor), both
   /// column-major with rows() rows. Not thread-safe, not even two solves at once: they share CHOLMOD's
@@ -65,6 +70,9 @@ class SparseCholesky {
   bool supernodal() const;
 
  private:
+  /// The numeric factorization on the analysis in place (refactorize's work); its caller holds CHOLMOD's
+  /// call guard.
+  bool factorizeNumerically(const Eigen::SparseMatrix<double>& matrix);
   struct Impl;
   std::unique_ptr<Impl> mImpl;
   Eigen::Index mRows = 0;
