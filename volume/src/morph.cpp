@@ -116,13 +116,15 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
   detail::SparseCholesky solver;
   const std::vector<int> order = detail::nodeBlockOrder(k);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
+  SparseMatrix a = k;
   for (int round = 0; round < rounds; ++round) {
     // From stiff (the fit moves the body nearly as a whole) to close: w from 0.1 to 100 times the
     // stiffness, in equal ratios.
     const double ratio = rounds == 1 ? 1.0 : std::pow(1000.0, static_cast<double>(round) / (rounds - 1));
     const double w = 0.1 * ratio * stiffnessScale / fitScale;
-    // A = K + the fit terms, which couple only nodes of one boundary face: within K's sparsity.
-    SparseMatrix a = k;
+    // A = K + the fit terms, which couple only nodes of one boundary face: within K's sparsity (so A is
+    // laid out once, and each round starts from K's values).
+    std::copy_n(k.valuePtr(), k.nonZeros(), a.valuePtr());
     double* values = a.valuePtr();
     bool inPattern = true;
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
