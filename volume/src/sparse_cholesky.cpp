@@ -1,7 +1,6 @@
 #include "sparse_cholesky.h"
 
 #include <algorithm>
-#include <array>
 #include <cholmod.h>
 #include <cstring>
 #include <dlfcn.h>
@@ -198,49 +197,35 @@ bool SparseCholesky::factorizeNumerically(const Eigen::SparseMatrix<double>& mat
   return true;
 }
 
-namespace {
-
-/// One CHOLMOD solve of `system` (CHOLMOD_A, _P, _L, ...) with `b`'s columns into `x`: false (and x all
-/// NaN) if CHOLMOD could not allocate its scratch space. `buffers` are the x, y, e that cholmod_solve2
-/// reuses from one call to the next.
-bool solveSystem(int system, cholmod_factor* factor, cholmod_common& common,
-                 std::array<cholmod_dense**, 3> buffers, Eigen::Index rows, const double* b, double* x,
-                 Eigen::Index columns) {
+bool SparseCholesky::solveSystem(int system, const double* b, double* x, Eigen::Index columns) const {
+  Impl& s = *mImpl;
   cholmod_dense rhs{};
-  rhs.nrow = rhs.d = static_cast<std::size_t>(rows);
+  rhs.nrow = rhs.d = static_cast<std::size_t>(mRows);
   rhs.ncol = static_cast<std::size_t>(columns);
   rhs.nzmax = rhs.nrow * rhs.ncol;
   rhs.x = const_cast<double*>(b);
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   const CallGuard guard;
-  if (!factor ||
-      !cholmod_solve2(system, factor, &rhs, nullptr, buffers[0], nullptr, buffers[1], buffers[2], &common)) {
+  if (!s.factor || !cholmod_solve2(system, s.factor, &rhs, nullptr, &s.x, nullptr, &s.y, &s.e, &s.common)) {
     std::fill(x, x + rhs.nzmax, std::numeric_limits<double>::quiet_NaN());
     return false;
   }
-  std::memcpy(x, (*buffers[0])->x, sizeof(double) * rhs.nzmax);
+  std::memcpy(x, s.x->x, sizeof(double) * rhs.nzmax);
   return true;
 }
 
-}  // namespace
-
 bool SparseCholesky::solve(const double* b, double* x, Eigen::Index columns) const {
-  Impl& s = *mImpl;
-  return solveSystem(CHOLMOD_A, s.factor, s.common, {&s.x, &s.y, &s.e}, mRows, b, x, columns);
+  return solveSystem(CHOLMOD_A, b, x, columns);
 }
 
 bool SparseCholesky::solveFactor(const double* b, double* x, Eigen::Index columns) const {
-  Impl& s = *mImpl;
   // x = P b, then L⁻¹ x in place of it (CHOLMOD's P and L systems are separate calls).
-  return solveSystem(CHOLMOD_P, s.factor, s.common, {&s.x, &s.y, &s.e}, mRows, b, x, columns) &&
-         solveSystem(CHOLMOD_L, s.factor, s.common, {&s.x, &s.y, &s.e}, mRows, x, x, columns);
+  return solveSystem(CHOLMOD_P, b, x, columns) && solveSystem(CHOLMOD_L, x, x, columns);
 }
 
 bool SparseCholesky::solveFactorTransposed(const double* b, double* x, Eigen::Index columns) const {
-  Impl& s = *mImpl;
-  return solveSystem(CHOLMOD_Lt, s.factor, s.common, {&s.x, &s.y, &s.e}, mRows, b, x, columns) &&
-         solveSystem(CHOLMOD_Pt, s.factor, s.common, {&s.x, &s.y, &s.e}, mRows, x, x, columns);
+  return solveSystem(CHOLMOD_Lt, b, x, columns) && solveSystem(CHOLMOD_Pt, x, x, columns);
 }
 
 bool SparseCholesky::supernodal() const {

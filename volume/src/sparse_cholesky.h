@@ -73,6 +73,10 @@ class SparseCholesky {
   /// The numeric factorization on the analysis in place (refactorize's work); its caller holds CHOLMOD's
   /// call guard.
   bool factorizeNumerically(const Eigen::SparseMatrix<double>& matrix);
+  /// One CHOLMOD solve of `system` (CHOLMOD_A, _P, _L, _Lt, _Pt) with b's columns into x: false (and x all
+  /// NaN) if there is no factor or CHOLMOD could not allocate its scratch space, which it reuses from one
+  /// call to the next. x may be b.
+  bool solveSystem(int system, const double* b, double* x, Eigen::Index columns) const;
   struct Impl;
   std::unique_ptr<Impl> mImpl;
   Eigen::Index mRows = 0;
