@@ -129,11 +129,17 @@ Eigen::MatrixXd rigidMotions(const std::vector<core::Vec3>& nodes, const SparseM
     r.block<3, 1>(3 * i, 4) = core::Vec3(p.z(), 0.0, -p.x());
     r.block<3, 1>(3 * i, 5) = core::Vec3(-p.y(), p.x(), 0.0);
   }
+  // Modified Gram–Schmidt with each finished column's product with M kept: ⟨r_k, r_j⟩_M = (M r_k) · r_j,
+  // M symmetric, so a pass costs six products with M, not one per pair.
+  Eigen::MatrixXd mr(3 * n, 6);
   for (int pass = 0; pass < 2; ++pass) {  // twice is enough (Kahan–Parlett)
     for (int j = 0; j < 6; ++j) {
       for (int k = 0; k < j; ++k)
-        r.col(j) -= r.col(k).dot(mass * r.col(j)) * r.col(k);
-      r.col(j) /= std::sqrt(r.col(j).dot(mass * r.col(j)));
+        r.col(j) -= mr.col(k).dot(r.col(j)) * r.col(k);
+      mr.col(j).noalias() = mass * r.col(j);
+      const double norm = std::sqrt(r.col(j).dot(mr.col(j)));
+      r.col(j) /= norm;
+      mr.col(j) /= norm;
     }
   }
   return r;
@@ -197,12 +203,12 @@ Result<ModalData> makeModalData(const Eigen::VectorXd& eigenvalues, const Eigen:
     data.rigidEigenvalues[i] = rigid[i] / firstElastic;
   data.eigenvalues = eigenvalues.head(options.modes);
   data.shapes = vectors.leftCols(options.modes);
-  const SparseMatrix& mass = fem.mass;
   // M-normalize explicitly (the solvers' own normalization is in their inner product, up to round-off),
   // and fix each sign so the largest component is positive: the same mesh gives the same bytes.
+  const Eigen::MatrixXd massShapes = fem.mass * data.shapes;
   for (int i = 0; i < options.modes; ++i) {
     auto phi = data.shapes.col(i);
-    phi /= std::sqrt(phi.dot(mass * phi));
+    phi /= std::sqrt(phi.dot(massShapes.col(i)));
     Eigen::Index arg = 0;  // a plain loop: Eigen's AVX-512 max reduction trips GCC 12's maybe-uninitialized
     for (Eigen::Index j = 1; j < phi.size(); ++j)
       if (std::abs(phi[j]) > std::abs(phi[arg])) arg = j;
@@ -520,9 +526,10 @@ Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMat
   // The rigid modes are known in closed form: detect them (K r ≈ 0, Rayleigh quotients near zero) and
   // deflate them, so that Lanczos looks for the elastic modes only.
   const Eigen::MatrixXd rigid = rigidMotions(nodes, fem.mass);
+  const Eigen::MatrixXd stiffRigid = fem.stiffness * rigid;
   std::array<double, 6> rigidEigenvalues{};
   for (int j = 0; j < 6; ++j)
-    rigidEigenvalues[static_cast<std::size_t>(j)] = rigid.col(j).dot(fem.stiffness * rigid.col(j));
+    rigidEigenvalues[static_cast<std::size_t>(j)] = rigid.col(j).dot(stiffRigid.col(j));
 
   // The shift: a small negative multiple of the stiffness scale (the ratio of the diagonals, near the
   // largest eigenvalue). Every eigenvalue is ≥ 0 > σ, so the smallest ones are the nearest to it; the
@@ -626,9 +633,10 @@ Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& s
     return Error{ErrorCode::kInvalidArgument, "the seeds must be finite, 3 values per node of the tet mesh"};
   // The start: the seeds' sum, each normalized, so that every seed mode is well represented in it.
   const auto start = [](const FemMatrices& fem, const Eigen::MatrixXd& all) {
+    const Eigen::MatrixXd massAll = fem.mass * all;
     Eigen::VectorXd sum = Eigen::VectorXd::Zero(all.rows());
     for (Eigen::Index j = 0; j < all.cols(); ++j) {
-      const double norm = std::sqrt(all.col(j).dot(fem.mass * all.col(j)));
+      const double norm = std::sqrt(all.col(j).dot(massAll.col(j)));
       if (norm > 0.0) sum += all.col(j) / norm;
     }
     return sum;
