@@ -20,13 +20,13 @@
 #include <malloc.h>
 #endif
 
-#include <Eigen/Geometry>
-
 #include <shapedb/core/physics.h>
 #include <shapedb/core/statistics.h>
 #include <shapedb/io/database.h>
 #include <shapedb/volume/correction.h>
 #include <shapedb/volume/families.h>
+
+#include "synthetic.h"
 
 namespace {
 
@@ -40,10 +40,8 @@ struct Sample {
 // The stretch: a random rotation's axes scaled by factors in [0.85, 1.15], about the origin (the entry's
 // centre of mass in its canonical frame).
 core::Mat3 randomStretch(std::mt19937_64& rng) {
-  std::normal_distribution<double> normal;
   std::uniform_real_distribution<double> factor(0.85, 1.15);
-  const Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-  const core::Mat3 r = q.normalized().toRotationMatrix();
+  const core::Mat3 r = test::randomRotation(rng);
   const core::Vec3 s(factor(rng), factor(rng), factor(rng));
   return r * s.asDiagonal() * r.transpose();
 }

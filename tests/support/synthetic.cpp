@@ -4,11 +4,19 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/Geometry>
+
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/volume/describe.h>
 
 namespace shapedb::test {
+
+core::Mat3 randomRotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q.normalized().toRotationMatrix();
+}
 
 core::TriangleMesh makeTorus(double major, double minor, int rings, int segments) {
   core::TriangleMesh m;

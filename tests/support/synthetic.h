@@ -8,8 +8,12 @@
 #include <shapedb/core/normalize.h>
 #include <shapedb/core/result.h>
 #include <shapedb/core/triangle_mesh.h>
+#include <shapedb/core/types.h>
 
 namespace shapedb::test {
+
+/// A uniformly distributed random rotation (unit quaternion from four normal deviates).
+core::Mat3 randomRotation(std::mt19937_64& rng);
 
 /// A closed blob with three distinct principal moments, skewed along every axis: an icosphere tapered
 /// along x and y (pear-shaped), bumped, and stretched by `radii`. No symmetry at all.

@@ -15,12 +15,6 @@
 
 namespace shapedb::test {
 
-core::Mat3 randomRotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-  return q.normalized().toRotationMatrix();
-}
-
 core::Mat4 randomSimilarity(std::mt19937_64& rng, double range, double minScale, double maxScale) {
   std::uniform_real_distribution<double> offset(-range, range);
   std::uniform_real_distribution<double> logScale(std::log(minScale), std::log(maxScale));

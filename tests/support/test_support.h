@@ -16,9 +16,6 @@
 
 namespace shapedb::test {
 
-/// A uniformly distributed random rotation (unit quaternion from four normal deviates).
-core::Mat3 randomRotation(std::mt19937_64& rng);
-
 /// A random similarity transform: random rotation, translation in [-range, range]³, uniform scale in
 /// [minScale, maxScale] (log-uniform).
 core::Mat4 randomSimilarity(std::mt19937_64& rng, double range = 10.0, double minScale = 0.1,
