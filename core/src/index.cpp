@@ -21,7 +21,8 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kProfileBins = 16;
-constexpr int kBlocksPerAxis = 4;  // the coarse 4³ block grid of the third bound
+constexpr std::uint32_t kLeafSlots = 16;  // entries per leaf of a bucket's cluster tree
+constexpr int kBlocksPerAxis = 4;         // the coarse 4³ block grid of the third bound
 // An odd number of levels, so that a centroid coordinate of exactly 0.5 (a wall that crosses its cell,
 // a face on the plane of symmetry) falls in the middle of a level rather than on the edge between two:
 // with 32, round-off of either sign split such coordinates between levels 15 and 16, and the same
@@ -225,11 +226,24 @@ struct Index::Impl {
     const std::uint64_t at = mCentroidAt[slot];
     return mCentroidChunks[at >> 32].data() + (at & 0xffffffffu);
   }
+  /// Starts loading what gridDistance reads of the entry in `slot`: its occupancy, and the first of
+  /// its centroids.
+  void prefetchRecord(std::size_t slot) const {
+    const auto* bits = reinterpret_cast<const char*>(&mBits[slot * mWords]);
+    for (std::size_t at = 0; at < mWords * sizeof(std::uint64_t); at += 64)
+      __builtin_prefetch(bits + at);
+    if (mOptions.kind != DescriptorKind::kCentroidVoxel) return;
+    const auto* first = reinterpret_cast<const char*>(centroids(slot));
+    const std::size_t bytes = std::min<std::size_t>(mCounts[slot] * sizeof(std::uint16_t), 512);
+    for (std::size_t at = 0; at < bytes; at += 64)
+      __builtin_prefetch(first + at);
+  }
   Query prepare(const Descriptor& descriptor, int candidate, double momentWeight) const;
   double momentTerm(const Query& q, std::size_t slot) const;
   double gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const;
   double gridBound(const Query& q, std::size_t slot, double moments) const;
-  double clusterBound(const Query& q, std::int32_t cluster, double threshold) const;
+  double clusterBound(const Query& q, std::int32_t cluster, double threshold,
+                      std::uint32_t* exclusive = nullptr) const;
   double countBound(const Query& q, std::uint32_t count) const;
   double mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const;
   void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
@@ -419,7 +433,8 @@ double Index::Impl::gridBound(const Query& q, std::size_t slot, double moments) 
 // cluster's range of that part; each ln moment differs at least by its distance to the cluster's
 // range. Summed in the same order as gridDistance and momentTerm sum theirs, term by term no larger,
 // so no larger in floating point either. Returns as soon as the terms so far exceed `threshold`.
-double Index::Impl::clusterBound(const Query& q, std::int32_t index, double threshold) const {
+double Index::Impl::clusterBound(const Query& q, std::int32_t index, double threshold,
+                                 std::uint32_t* exclusive) const {
   const Cluster& cluster = mClusters[static_cast<std::size_t>(index)];
   const std::uint32_t count = cluster.count;
   double moments = 0.0;
@@ -434,6 +449,7 @@ double Index::Impl::clusterBound(const Query& q, std::int32_t index, double thre
   }
   // The cheapest terms first: the moments and the count may already put the cluster past the threshold.
   std::uint32_t best = absoluteDifference(count, q.count);
+  if (exclusive) *exclusive = best;
   if (const double bound = mismatchDistance(best, count + q.count) + moments; bound > threshold) return bound;
   const std::uint64_t* all = &mClusterBits[static_cast<std::size_t>(index) * 2 * mWords];
   const std::uint64_t* any = all + mWords;
@@ -442,6 +458,7 @@ double Index::Impl::clusterBound(const Query& q, std::int32_t index, double thre
     surely +=
         static_cast<std::uint32_t>(std::popcount(q.bits[w] & ~any[w]) + std::popcount(all[w] & ~q.bits[w]));
   best = std::max(best, surely);
+  if (exclusive) *exclusive = best;
   if (const double bound = mismatchDistance(best, count + q.count) + moments; bound > threshold) return bound;
   const std::uint8_t* b = q.profile.data();
   const std::uint8_t* least = cluster.least.data();
@@ -452,6 +469,7 @@ double Index::Impl::clusterBound(const Query& q, std::int32_t index, double thre
     const std::size_t at = static_cast<std::size_t>(axis) * kProfileBins;
     best = std::max(best, distanceToRangeSum<kProfileBins>(b + at, least + at, most + at));
   }
+  if (exclusive) *exclusive = best;
   return mismatchDistance(best, count + q.count) + moments;
 }
 
@@ -486,10 +504,13 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
     struct Pending {
       std::int32_t cluster;
       double bound;
+      std::uint32_t exclusive;  // the least count of cells filled in one grid only, over its entries
     };
     std::array<Pending, 128> stack;  // a tree of < 2³² slots is < 32 deep; one sibling waits per level
     std::size_t depth = 0;
-    stack[depth++] = {root, clusterBound(q, root, std::min(shared, local.threshold()))};
+    stack[depth] = {root, 0.0, 0};
+    stack[depth].bound = clusterBound(q, root, std::min(shared, local.threshold()), &stack[depth].exclusive);
+    ++depth;
     ++st.groupBoundEvaluations;
     while (depth > 0) {
       const Pending pending = stack[--depth];
@@ -498,26 +519,64 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
       if (cluster.left >= 0) {
         // Both children's loads at once, rather than one after the other: the walk is bound by memory.
         for (const std::int32_t child : {cluster.left, cluster.right}) {
-          __builtin_prefetch(&mClusters[static_cast<std::size_t>(child)]);
-          __builtin_prefetch(&mClusterBits[static_cast<std::size_t>(child) * 2 * mWords]);
+          const auto* record = reinterpret_cast<const char*>(&mClusters[static_cast<std::size_t>(child)]);
+          for (std::size_t at = 0; at < sizeof(Cluster); at += 64)
+            __builtin_prefetch(record + at);
+          const auto* bits =
+              reinterpret_cast<const char*>(&mClusterBits[static_cast<std::size_t>(child) * 2 * mWords]);
+          for (std::size_t at = 0; at < 2 * mWords * sizeof(std::uint64_t); at += 64)
+            __builtin_prefetch(bits + at);
         }
         const double threshold = std::min(shared, local.threshold());
-        const Pending left{cluster.left, clusterBound(q, cluster.left, threshold)};
-        const Pending right{cluster.right, clusterBound(q, cluster.right, threshold)};
+        Pending left{cluster.left, 0.0, 0}, right{cluster.right, 0.0, 0};
+        left.bound = clusterBound(q, cluster.left, threshold, &left.exclusive);
+        right.bound = clusterBound(q, cluster.right, threshold, &right.exclusive);
         st.groupBoundEvaluations += 2;
+        // A leaf that may be opened: its entries' moments and counts start loading now.
+        for (const Pending& child : {left, right}) {
+          const Cluster& c = mClusters[static_cast<std::size_t>(child.cluster)];
+          if (c.left >= 0 || child.bound > threshold) continue;
+          const auto* moments = reinterpret_cast<const char*>(&mMoments[c.begin]);
+          for (std::size_t at = 0; at < (c.end - c.begin) * sizeof(Vec3); at += 64)
+            __builtin_prefetch(moments + at);
+          const auto* profiles = reinterpret_cast<const char*>(profile(c.begin));
+          for (std::size_t at = 0; at < (c.end - c.begin) * kProfileBytes; at += 64)
+            __builtin_prefetch(profiles + at);
+        }
         // The farther below the nearer, so that the nearer is taken first.
         const bool leftFirst = left.bound <= right.bound;
         stack[depth++] = leftFirst ? right : left;
         stack[depth++] = leftFirst ? left : right;
         continue;
       }
+      // Every entry of the leaf has at least its `exclusive` cells filled in one grid only: with the
+      // entry's own moment term, that rules many out before their counts are read.
+      const double leafMismatch = mismatchDistance(pending.exclusive, cluster.count + q.count);
+      // First the bounds of the whole leaf, fetching the records of the entries they leave in, then
+      // their distances: the loads of several entries overlap, where one after the other each distance
+      // would wait for its own.
+      struct Survivor {
+        std::size_t slot;
+        double bound, moments;
+      };
+      std::array<Survivor, kLeafSlots> survivors;
+      std::size_t survivorCount = 0;
+      const double leafThreshold = std::min(shared, local.threshold());
       for (std::size_t slot = cluster.begin; slot < cluster.end; ++slot) {
         ++st.boundEvaluations;
-        const double threshold = std::min(shared, local.threshold());
         const double moments = momentTerm(q, slot);
-        if (gridBound(q, slot, moments) > threshold) continue;
+        if (leafMismatch + moments > leafThreshold) continue;
+        const double bound = gridBound(q, slot, moments);
+        if (bound > leafThreshold) continue;
+        prefetchRecord(slot);
+        survivors[survivorCount++] = {slot, bound, moments};
+      }
+      for (std::size_t i = 0; i < survivorCount; ++i) {
+        const Survivor& s = survivors[i];
+        const double threshold = std::min(shared, local.threshold());
+        if (s.bound > threshold) continue;
         ++st.distanceEvaluations;
-        local.push(gridDistance(q, slot, threshold, moments), mIds[slot], q.candidate, moments);
+        local.push(gridDistance(q, s.slot, threshold, s.moments), mIds[s.slot], q.candidate, s.moments);
       }
     }
   };
@@ -701,7 +760,6 @@ Result<std::vector<Match>> Index::search(std::span<const Descriptor> candidates,
 
 namespace {
 
-constexpr std::uint32_t kLeafSlots = 16;
 // Centroids per chunk (2 MiB): an entry's never straddle two, and a chunk, once full, never moves.
 constexpr std::size_t kCentroidChunk = std::size_t{1} << 20;
 
