@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/tetrahedralize.h>
@@ -35,6 +37,19 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, 
 }
 
 namespace {
+
+/// Whether `mesh` fills the surface whose mass properties are `mass`: the same volume and centroid to
+/// 1e-9 (relative), as tets whose boundary lies on the surface's faces do.
+Status fillsSurface(const TetMesh& mesh, const core::MassProperties& mass) {
+  const double volume = mass.volume;
+  const core::MassProperties filled = core::computeTetMassProperties(mesh);
+  if (std::abs(filled.volume - volume) > 1e-9 * volume ||
+      (filled.centerOfMass - mass.centerOfMass).norm() > 1e-9 * std::cbrt(volume)) {
+    return Error{ErrorCode::kParse, "TetGen moved the surface: its tets hold " +
+                                        std::to_string(filled.volume / volume) + " of the volume"};
+  }
+  return Ok{};
+}
 
 /// One TetGen run with these switches, its output checked and turned positive, and checked to fill the
 /// surface: same volume and centroid to 1e-9 (relative).
@@ -77,12 +92,7 @@ Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const Tetrahedra
     return Error{ErrorCode::kParse, "TetGen's tets make " + std::to_string(pieces) +
                                         " pieces joined only at edges or nodes once its flat tets are "
                                         "dropped (a mechanism, which would ring at a near-zero frequency)"};
-  const core::MassProperties filled = core::computeTetMassProperties(mesh);
-  if (std::abs(filled.volume - volume) > 1e-9 * volume ||
-      (filled.centerOfMass - mass.centerOfMass).norm() > 1e-9 * std::cbrt(volume)) {
-    return Error{ErrorCode::kParse, "TetGen moved the surface: its tets hold " +
-                                        std::to_string(filled.volume / volume) + " of the volume"};
-  }
+  if (Status fills = fillsSurface(mesh, mass); !fills) return fills.error();
   return mesh;
 }
 
@@ -106,20 +116,23 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // fresh worker, so that a broken worker never changes the mesh. (Under ASan on a loaded machine a
   // worker hung until its timeout now and then; the unmerged run that followed gave another mesh, and a
   // resumed database differed from a clean one.)
-  auto once = [&](const TetrahedralizeOptions& o, bool mergeFacets) {
-    Result<TetMesh> result = tetrahedralizeOnce(surface, o, *mass, mergeFacets);
+  auto once = [](const TriangleMesh& input, const core::MassProperties& inputMass,
+                 const TetrahedralizeOptions& o, bool mergeFacets) {
+    Result<TetMesh> result = tetrahedralizeOnce(input, o, inputMass, mergeFacets);
     if (!result && result.error().code == ErrorCode::kIo && o.guarded && o.relaxOnFailure)
-      result = tetrahedralizeOnce(surface, o, *mass, mergeFacets);
+      result = tetrahedralizeOnce(input, o, inputMass, mergeFacets);
     return result;
   };
-  auto attempt = [&](const TetrahedralizeOptions& o) {
-    Result<TetMesh> result = once(o, /*mergeFacets=*/true);
+  auto attemptOn = [&](const TriangleMesh& input, const core::MassProperties& inputMass,
+                       const TetrahedralizeOptions& o) {
+    Result<TetMesh> result = once(input, inputMass, o, /*mergeFacets=*/true);
     if (!result) {
-      Result<TetMesh> unmerged = once(o, /*mergeFacets=*/false);
+      Result<TetMesh> unmerged = once(input, inputMass, o, /*mergeFacets=*/false);
       if (unmerged) result = std::move(unmerged);
     }
     return result;
   };
+  auto attempt = [&](const TetrahedralizeOptions& o) { return attemptOn(surface, *mass, o); };
   Result<TetMesh> tets = attempt(options);
   if (!options.relaxOnFailure) return tets;
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
@@ -132,7 +145,37 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
     tets = attempt(looser);
   }
-  return tets;
+  if (tets) return tets;
+  // TetGen 1.5.0 asserts in its point location ("finddirection: nonconvex") on some surfaces whose
+  // vertices are symmetric about the coordinate planes: two uv-ellipsoids of 12 segments and 6 stacks in
+  // the default catalog did, at every bound. The same surface turned by a generic rotation meshes; its
+  // nodes are turned back and the surface's own vertices (TetGen keeps them first, in order) restored
+  // exactly, so that the tets fill the surface as any run's do.
+  const core::Mat3 turn = Eigen::AngleAxisd(0.37, core::Vec3(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+  TriangleMesh turned = surface;
+  for (core::Vec3& v : turned.vertices)
+    v = turn * v;
+  const auto turnedMass = core::computeMassProperties(turned);
+  if (!turnedMass) return tets;
+  Result<TetMesh> turnedTets = attemptOn(turned, *turnedMass, options);
+  if (!turnedTets) return tets;
+  TetMesh back = std::move(turnedTets).value();
+  if (back.nodes.size() < surface.vertices.size()) return tets;
+  const double tolerance = 1e-9 * std::cbrt(mass->volume);
+  for (std::size_t i = 0; i < back.nodes.size(); ++i) {
+    const core::Vec3 node = turn.transpose() * back.nodes[i];
+    if (i >= surface.vertices.size()) {
+      back.nodes[i] = node;
+    } else if ((node - surface.vertices[i]).norm() <= tolerance) {
+      back.nodes[i] = surface.vertices[i];
+    } else {
+      return tets;  // not the surface's vertex: TetGen numbered them otherwise
+    }
+  }
+  if (!core::validateTetMesh(back) || !fillsSurface(back, *mass)) return tets;
+  for (std::size_t t = 0; t < back.tets.size(); ++t)
+    if (core::tetVolume(back, t) <= 0.0) return tets;
+  return back;
 }
 
 // A surface whose faces are only nearly coplanar (a level-set mesh: float coordinates) leaves wedges of
