@@ -111,7 +111,7 @@ volume::StageTimes timesFromJson(const json& j) {
 }  // namespace
 
 volume::ShapeResolution entryResolution(volume::ElementOrder order) {
-  return order == volume::ElementOrder::kQuadratic ? volume::ShapeResolution{.segments = 16, .stacks = 8}
+  return order == volume::ElementOrder::kQuadratic ? volume::ShapeResolution{.segments = 12, .stacks = 6}
                                                    : volume::ShapeResolution{.segments = 24, .stacks = 12};
 }
 

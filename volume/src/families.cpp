@@ -462,8 +462,10 @@ Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolutio
     case Family::kShell:
       return detail::makeShellShape(static_cast<detail::ShellKind>(spec.index % 4), a, b, spec.params.z(),
                                     segments);
-    case Family::kLimbed:
-      return detail::makeLimbedShape(static_cast<int>(a), b, spec.params.z(), rng, maxTriangles);
+    case Family::kLimbed:  // thin limbs: never fewer triangles than 16 segments give (docs/accuracy.md)
+      return detail::makeLimbedShape(
+          static_cast<int>(a), b, spec.params.z(), rng,
+          std::max(maxTriangles, std::size_t{16} * resolution.trianglesPerSegment));
     case Family::kUnion:
       return detail::makeUnionShape(static_cast<int>(a), rng, maxTriangles);
     case Family::kUser:
