@@ -26,8 +26,8 @@ inline constexpr int kSchemaVersion = 1;
 /// stacks (16 and 8 until 2026-11-27), which take a third to a half of the curved entries' tets and of
 /// their modes' cost against 16 and 8, the modes still within about 2 % of the same surface meshed three
 /// times finer (docs/accuracy.md); a 12-sided section holds 95.5 % of its circle's area (the entry is the
-/// polygon: its data are that shape's). Limbed bodies keep the triangles of 16 segments, which their thin
-/// limbs need. Linear: 24 and 12, as databases of linear tets have always been built.
+/// polygon: its data are that shape's). Shells and limbed bodies keep 16 segments, which their thin walls
+/// and limbs need. Linear: 24 and 12, as databases of linear tets have always been built.
 volume::ShapeResolution entryResolution(volume::ElementOrder order);
 
 /// What a database was built with. Stored in the file; every entry of a file shares them. The defaults
