@@ -172,9 +172,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
       return tets;  // not the surface's vertex: TetGen numbered them otherwise
     }
   }
-  if (!core::validateTetMesh(back) || !fillsSurface(back, *mass)) return tets;
-  for (std::size_t t = 0; t < back.tets.size(); ++t)
-    if (core::tetVolume(back, t) <= 0.0) return tets;
+  if (!core::validateTetMesh(back) || !fillsSurface(back, *mass)) return tets;  // flat, inverted, moved
   return back;
 }
 
