@@ -3,7 +3,8 @@
 // in [0.85, 1.15]), then the modes computed again on them, with the database's modal options, as a query
 // with --correct --correct-candidates 1 does. Per family and over all the entries sampled (an even sample
 // of the catalog, so its medians are a default entry's): the entry's tets and the quadratic mesh's degrees
-// of freedom, and the morph's, the modes' and the whole correction's median and p90 (milliseconds).
+// of freedom, the morph's and the modes' median time, the median count of the modes' solves with the
+// factorized K − σM (Lanczos's operations), and the whole correction's median and p90 (milliseconds).
 // Run it on one core (taskset -c 0): a query corrects on one, and so does a haptic worker. Freed memory is
 // kept in the heap as the command-line tool keeps it (cli/main.cpp): otherwise page faults on the
 // matrices' fresh blocks add ~40 % to the modes of a small entry on a VM.
@@ -35,6 +36,7 @@ using namespace shapedb;
 struct Sample {
   std::size_t tets = 0;
   double dof = 0.0, morphMs = 0.0, modesMs = 0.0;
+  int solves = 0;  ///< Lanczos's solves with the factorized K − σM (CorrectionReport::solves)
 };
 
 // The stretch: a random rotation's axes scaled by factors in [0.85, 1.15], about the origin (the entry's
@@ -47,17 +49,19 @@ core::Mat3 randomStretch(std::mt19937_64& rng) {
 }
 
 void printRow(const std::string& name, const std::vector<Sample>& samples) {
-  std::vector<double> tets, dof, morph, modes, total;
+  std::vector<double> tets, dof, morph, modes, total, solves;
   for (const Sample& s : samples) {
     tets.push_back(static_cast<double>(s.tets));
+    solves.push_back(s.solves);
     dof.push_back(s.dof);
     morph.push_back(s.morphMs);
     modes.push_back(s.modesMs);
     total.push_back(s.morphMs + s.modesMs);
   }
-  std::printf("| %s | %zu | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f |\n", name.c_str(), samples.size(),
+  std::printf("| %s | %zu | %.0f | %.0f | %.1f | %.1f | %.0f | %.1f | %.1f |\n", name.c_str(), samples.size(),
               core::percentile(tets, 0.5), core::percentile(dof, 0.5), core::percentile(morph, 0.5),
-              core::percentile(modes, 0.5), core::percentile(total, 0.5), core::percentile(total, 0.9));
+              core::percentile(modes, 0.5), core::percentile(solves, 0.5), core::percentile(total, 0.5),
+              core::percentile(total, 0.9));
 }
 
 }  // namespace
@@ -115,14 +119,15 @@ int main(int argc, char** argv) {
                 : 3.0 * static_cast<double>((*physics)->tetMesh.nodeCount());
     s.morphMs = 1e3 * report.morphSeconds;
     s.modesMs = 1e3 * report.modesSeconds;
+    s.solves = report.solves;
     byFamily[volume::toString(record.family)].push_back(s);
     all.push_back(s);
   }
   std::printf("%s: every %zu-th of %zu entries, %s tets, %d modes; %d failed\n\n", argv[1], every,
               entries.size(), volume::toString(modal.order), modal.modes, failed);
   std::printf(
-      "| family | entries | median tets | median dof | morph p50 (ms) | modes p50 | correction p50 | "
-      "correction p90 |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| family | entries | median tets | median dof | morph p50 (ms) | modes p50 | solves p50 | "
+      "correction p50 | correction p90 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [family, samples] : byFamily)
     printRow(family, samples);
   printRow("**all**", all);
