@@ -1,6 +1,7 @@
 // A fracture's burst: a mesh broken into fragments that all need physical data at one instant.
 //
-//   build/release/bin/burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--units mm|cm|m|in|ft]
+//   build/release/bin/burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--cache E]
+//                                 [--units mm|cm|m|in|ft]
 //
 // MESH is broken with shapedb's fracture (N Voronoi pieces, default 200; the default resolution), then the
 // fragments are answered R times (default 5) each way, and the medians over the runs are reported:
@@ -12,6 +13,7 @@
 //     queryMany (the figure a burst replaces);
 //   - per stage, the median over the fragments of the warm one-at-a-time queries (microseconds).
 // Queries skip the fidelity report unless --fidelity is given (an interactive burst does not need it).
+// --cache sets the Database's entry cache (Database::OpenOptions::cacheEntries; its default otherwise).
 // The machine's cores are all used by the bursts (TBB); `taskset -c 0` measures one core.
 
 #include <chrono>
@@ -52,6 +54,7 @@ bool allAnswered(const std::vector<shapedb::Result<io::QueryResult>>& results) {
 int main(int argc, char** argv) {
   std::vector<std::string> positional;
   int pieces = 200, runs = 5;
+  std::optional<std::size_t> cacheEntries;
   bool fidelity = false;
   double scale = 1.0;
   for (int i = 1; i < argc; ++i) {
@@ -59,6 +62,13 @@ int main(int argc, char** argv) {
       pieces = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) {
       runs = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
+      const int entries = std::atoi(argv[++i]);
+      if (entries < 1) {
+        std::fprintf(stderr, "burst_bench: --cache takes a number of entries ≥ 1\n");
+        return 2;
+      }
+      cacheEntries = static_cast<std::size_t>(entries);
     } else if (!std::strcmp(argv[i], "--fidelity")) {
       fidelity = true;
     } else if (!std::strcmp(argv[i], "--units") && i + 1 < argc) {
@@ -77,7 +87,8 @@ int main(int argc, char** argv) {
   }
   if (positional.size() != 2 || pieces < 1 || runs < 1) {
     std::fprintf(stderr,
-                 "usage: burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--units mm|cm|m|in|ft]\n");
+                 "usage: burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--cache E]\n"
+                 "                   [--units mm|cm|m|in|ft]\n");
     return 2;
   }
   const std::string dbPath = positional[0], meshPath = positional[1];
@@ -112,6 +123,7 @@ int main(int argc, char** argv) {
   std::vector<double> validate, mass, describe, search, fetch, adapt, link, total;
   io::Database::OpenOptions open;
   open.descriptors = {options.descriptor};  // the one index the burst searches, as shapedb query opens
+  if (cacheEntries) open.cacheEntries = *cacheEntries;
   for (int run = 0; run < runs; ++run) {
     Clock::time_point start = Clock::now();
     auto db = io::Database::open(dbPath, open);
