@@ -29,7 +29,7 @@ fracture(V, F, *, pieces=20, seed=1, resolution=0, max_triangles=3000) -> dict
 materials(), families()
     The material presets' and the catalog families' names.
 
-Database(path, *, cache_entries=64, descriptors=None)
+Database(path, *, cache_entries=256, descriptors=None)
     ``query(V, F, *, k=1, descriptor="centroid-voxel", material="steel", correct=False, fidelity=True,
     approximate=False, adapt=True, correction_candidates=3) -> QueryResult``; ``query_many(meshes, ...)``
     answers a list of (V, F) at once over all cores, in input order, a failed mesh's :class:`Error` in its

@@ -554,7 +554,8 @@ PYBIND11_MODULE(_shapedb, m) {
 
   py::class_<PyDatabase>(m, "Database")
       .def(py::init<const std::string&, std::size_t, const std::optional<std::vector<std::string>>&>(),
-           "path"_a, py::kw_only(), "cache_entries"_a = 64, "descriptors"_a = py::none())
+           "path"_a, py::kw_only(), "cache_entries"_a = io::Database::OpenOptions{}.cacheEntries,
+           "descriptors"_a = py::none())
       .def(
           "query",
           [](const PyDatabase& db, const py::object& v, const py::object& f, int k,
