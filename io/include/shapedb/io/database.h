@@ -132,7 +132,7 @@ class Database {
   struct OpenOptions {
     /// Entries' physical data kept in RAM, each with its point locator, least recently used dropped first.
     /// 256 holds a fracture burst's (200 fragments match about 160 entries of the default database), so
-    /// that the next burst finds them (bench/burst_bench.cpp: a warm burst 212 → 160 ms against 64); a
+    /// that the next burst finds them (bench/burst_bench.cpp: a warm burst 212 → 154 ms against 64); a
     /// cached entry of the default database takes 551 KB on average, so about 140 MB when full.
     std::size_t cacheEntries = 256;
     /// If set, the file must have been built with these descriptor parameters (grid size, sampling).
