@@ -61,18 +61,27 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
                                   std::size_t candidates, const volume::ModalOptions& modal,
                                   const volume::CorrectionOptions& options) {
   Correction out;
+  // The query's surface in its canonical frame, prepared once (its closest-point tree, side test, moments):
+  // each candidate sees it through its own orientation, which carries that frame into the entry's.
+  const Clock::time_point start = Clock::now();
+  core::TriangleMesh canonical = mesh;
+  const core::Placement unoriented = core::placementOf(q.normalization, core::Mat3::Identity());
+  for (core::Vec3& p : canonical.vertices)
+    p = unoriented.toEntry(p);
+  auto target = volume::MorphTarget::prepare(std::move(canonical));
+  if (!target) {
+    out.error = target.error().message;
+    return out;
+  }
+  double morphSeconds = std::chrono::duration<double>(Clock::now() - start).count();
   // The candidates' morphs at once (each its own task: on a free core, the correction waits for the
   // slowest morph rather than for all of them), then chosen in rank order, the better rank among equals.
   std::vector<std::optional<Result<volume::MorphedEntry>>> morphs(candidates);
   tbb::parallel_for(std::size_t{0}, candidates, [&](std::size_t i) {
-    const core::Placement placement = core::placementOf(q.normalization, q.matches[i].match.orientation);
-    core::TriangleMesh target = mesh;
-    for (core::Vec3& p : target.vertices)
-      p = placement.toEntry(p);
-    morphs[i] = volume::morphEntry(entries[i]->data, target, options);
+    const volume::MorphTarget::View view(*target, q.matches[i].match.orientation);
+    morphs[i] = volume::morphEntry(entries[i]->data, view, options, volume::MissingMass::kDeferred);
   });
   std::optional<volume::MorphedEntry> chosen;
-  double morphSeconds = 0.0;
   for (std::size_t i = 0; i < candidates; ++i) {
     Result<volume::MorphedEntry>& morphed = *morphs[i];
     if (!morphed) {
@@ -86,8 +95,11 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     }
   }
   if (!chosen) return out;
+  const Clock::time_point placing = Clock::now();
+  volume::placeMissingMass(*chosen,
+                           volume::MorphTarget::View(*target, q.matches[out.answered].match.orientation));
   chosen->report.morphs = static_cast<int>(candidates);
-  chosen->report.morphSeconds = morphSeconds;
+  chosen->report.morphSeconds = morphSeconds + std::chrono::duration<double>(Clock::now() - placing).count();
   auto c = volume::correctMorphed(entries[out.answered]->data, std::move(*chosen), modal);
   if (!c) {
     out.error = c.error().message;

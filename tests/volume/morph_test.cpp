@@ -85,6 +85,45 @@ TEST(Morph, EveryTetStaysPositiveOrTheMorphIsRefused) {
   EXPECT_GE(morphed, 6);
 }
 
+// The shared preparation against its oracle: a target prepared once and seen through an orthogonal frame
+// (a query's candidate entries each see its surface so) morphs a mesh as a copy of the surface carried
+// into that frame does. Random rotations, and one with a reflection (whose copy is wound again outward).
+TEST(Morph, APreparedTargetSeenThroughAFrameMorphsAsACopyCarriedIntoIt) {
+  Result<TetMesh> tets = tetrahedralize(core::makeUvEllipsoid(Vec3(1.0, 0.8, 0.6), 16, 8),
+                                        entryMeshing(ElementOrder::kQuadratic));
+  ASSERT_TRUE(tets.ok()) << tets.error().message;
+  // A box of other proportions, twisted about x: the morph has all three of its steps to do.
+  core::TriangleMesh surface = core::makeBox(Vec3(2.2, 1.1, 0.7));
+  for (Vec3& p : surface.vertices) {
+    const double a = 0.4 * p.x();
+    p = Vec3(p.x(), std::cos(a) * p.y() - std::sin(a) * p.z(), std::sin(a) * p.y() + std::cos(a) * p.z());
+  }
+  Result<MorphTarget> prepared = MorphTarget::prepare(surface);
+  ASSERT_TRUE(prepared.ok()) << prepared.error().message;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 4; ++trial) {
+    core::Mat3 frame = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+                           .normalized()
+                           .toRotationMatrix();
+    if (trial == 3) frame.col(2) *= -1.0;
+    core::Mat4 map = core::Mat4::Identity();
+    map.topLeftCorner<3, 3>() = frame;
+    const TetMesh& mesh = *tets;
+    Result<MorphResult> viewed = morphTetMesh(mesh, MorphTarget::View(*prepared, frame));
+    Result<MorphResult> copied = morphTetMesh(mesh, core::transformed(surface, map));
+    ASSERT_TRUE(viewed.ok() && copied.ok()) << "trial " << trial;
+    EXPECT_GT(viewed->report.maxBoundaryMove, 0.1) << "trial " << trial;
+    EXPECT_NEAR(viewed->report.meanTargetDistance, copied->report.meanTargetDistance, 1e-9)
+        << "trial " << trial;
+    EXPECT_NEAR(viewed->report.projected, copied->report.projected, 1e-9) << "trial " << trial;
+    EXPECT_EQ((viewed->report.stretch - copied->report.stretch).norm() < 1e-9, true) << "trial " << trial;
+    for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
+      ASSERT_LT((viewed->mesh.nodes[v] - copied->mesh.nodes[v]).norm(), 1e-8)
+          << "trial " << trial << " node " << v;
+  }
+}
+
 TEST(Morph, BadInputIsAnError) {
   Result<TetMesh> tets = tetrahedralize(core::makeBox(Vec3(1, 1, 1)), entryMeshing(ElementOrder::kQuadratic));
   ASSERT_TRUE(tets.ok()) << tets.error().message;
@@ -92,6 +131,7 @@ TEST(Morph, BadInputIsAnError) {
   EXPECT_EQ(morphTetMesh(*tets, core::makeBox(Vec3(1, 1, 1)), {.minQuality = 0.0}).error().code,
             ErrorCode::kInvalidArgument);
   EXPECT_EQ(morphTetMesh(TetMesh{}, core::makeBox(Vec3(1, 1, 1))).error().code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(MorphTarget::prepare(core::TriangleMesh{}).error().code, ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

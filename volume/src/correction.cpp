@@ -19,13 +19,13 @@ double secondsSince(Clock::time_point start) {
 
 // `mass` shared among the nodes of `tets` next to where `target` lies outside them (MorphedEntry::
 // pointMasses); empty if no vertex of the target lies outside.
-std::vector<double> missingMass(const core::TetMesh& tets, const core::TriangleMesh& target, double mass) {
-  const std::vector<double> area = core::vertexAreaWeights(target);
+std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::View& target, double mass) {
+  const std::vector<double>& area = target.target().vertexAreas();
   const core::TetLocator locator(tets);
   core::TetLocator::Hint hint;
   std::vector<double> share(tets.nodeCount(), 0.0);
-  for (std::size_t v = 0; v < target.vertices.size(); ++v) {
-    const core::TetLocation at = locator.locate(target.vertices[v], hint);
+  for (std::size_t v = 0; v < target.vertexCount(); ++v) {
+    const core::TetLocation at = locator.locate(target.vertex(v), hint);
     if (at.inside() || area[v] == 0.0) continue;
     const double gap = area[v] * at.distance;
     // The closest point is on a boundary face of at.tet: the node across from it has weight 0, to
@@ -42,15 +42,14 @@ std::vector<double> missingMass(const core::TetMesh& tets, const core::TriangleM
 
 // CorrectionReport::strayShare: the volume of the tets whose centroid lies outside `target`, over all
 // of theirs.
-double strayShare(const core::TetMesh& tets, const core::TriangleMesh& target) {
-  const core::SurfaceSide side(target);
+double strayShare(const core::TetMesh& tets, const MorphTarget::View& target) {
   double outside = 0.0, total = 0.0;
   for (std::size_t t = 0; t < tets.tetCount(); ++t) {
     const core::Vec3 centroid = 0.25 * (tets.nodes[tets.tets[t][0]] + tets.nodes[tets.tets[t][1]] +
                                         tets.nodes[tets.tets[t][2]] + tets.nodes[tets.tets[t][3]]);
     const double volume = std::abs(core::tetVolume(tets, t));
     total += volume;
-    if (!side.inside(centroid)) outside += volume;
+    if (!target.inside(centroid)) outside += volume;
   }
   return total > 0.0 ? outside / total : 0.0;
 }
@@ -59,6 +58,16 @@ double strayShare(const core::TetMesh& tets, const core::TriangleMesh& target) {
 
 Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::TriangleMesh& target,
                                 const CorrectionOptions& options) {
+  const Clock::time_point start = Clock::now();
+  auto prepared = MorphTarget::prepare(target);
+  if (!prepared) return prepared.error();
+  auto out = morphEntry(entry, prepared->view(), options);
+  if (out) out->report.morphSeconds = secondsSince(start);
+  return out;
+}
+
+Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const MorphTarget::View& target,
+                                const CorrectionOptions& options, MissingMass missing) {
   if (entry.modes.shapes.rows() != static_cast<Eigen::Index>(3 * entry.tetMesh.nodeCount()) ||
       entry.modes.shapes.cols() < 1)
     return Error{ErrorCode::kInvalidArgument, "correction: the entry's mode shapes do not fit its tet mesh"};
@@ -76,18 +85,24 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::Tri
   // them, share the missing mass among the corners of the boundary faces nearest to them. Scaling the tets
   // up to the target's volume, as before, thickened the whole body, stiffness with the mass, and left the
   // corrected first frequencies higher (docs/architecture.md).
-  Result<core::MassProperties> targetMass = core::computeMassProperties(target);
+  const std::optional<core::MassProperties>& targetMass = target.target().massProperties();
   const double volume = core::computeTetMassProperties(out.tetMesh).volume;
-  if (targetMass && std::isfinite(targetMass->volume / volume) && targetMass->volume > 0.0) {
+  if (targetMass && std::isfinite(targetMass->volume / volume) && targetMass->volume > 0.0)
     out.report.massScale = targetMass->volume / volume;
-    if (targetMass->volume > volume)
-      out.pointMasses = missingMass(out.tetMesh, target, targetMass->volume - volume);
-  }
+  if (missing == MissingMass::kPlaced) placeMissingMass(out, target);
   // A side is defined only for a surface that bounds a solid (closed and oriented, the precondition of
   // SurfaceSide, which computeMassProperties checks): for any other the share stays 0, unknown.
   if (targetMass) out.report.strayShare = strayShare(out.tetMesh, target);
   out.report.morphSeconds = secondsSince(start);
   return out;
+}
+
+void placeMissingMass(MorphedEntry& morphed, const MorphTarget::View& target) {
+  const std::optional<core::MassProperties>& targetMass = target.target().massProperties();
+  if (!targetMass) return;
+  const double volume = core::computeTetMassProperties(morphed.tetMesh).volume;
+  if (std::isfinite(targetMass->volume / volume) && targetMass->volume > volume && volume > 0.0)
+    morphed.pointMasses = missingMass(morphed.tetMesh, target, targetMass->volume - volume);
 }
 
 bool betterMorph(const CorrectionReport& a, const CorrectionReport& b) {

@@ -96,17 +96,16 @@ std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh)
 /// both ways, then the total displacement U that minimizes Uᵀ K U + w Σ (fit terms), K the mesh-motion
 /// stiffness of the start configuration, w growing round by round. A round whose displacement would push a
 /// tet under `minQuality` is taken in part (halved up to three times) or not at all.
-void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::TriangleMesh& target,
-                         const core::ClosestPointTree& targetTree, int rounds, double minQuality,
-                         detail::MotionStiffness& stiffness) {
+void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTarget::View& target, int rounds,
+                         double minQuality, detail::MotionStiffness& stiffness) {
   if (rounds <= 0) return;
   const TetMesh start = mesh;
   const SparseMatrix k = stiffness.assemble(start);
   const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
   const std::vector<double> nodeArea = boundaryAreas(boundary, start);
   // The target's side: up to 2,000 of its vertices, each with its share of the target's area.
-  const std::vector<double> vertexArea = core::vertexAreaWeights(target);
-  const std::size_t stride = std::max<std::size_t>(1, target.vertices.size() / 2000);
+  const std::vector<double>& vertexArea = target.target().vertexAreas();
+  const std::size_t stride = std::max<std::size_t>(1, target.vertexCount() / 2000);
   double stiffnessScale = 0.0, fitScale = 0.0;
   for (Eigen::Index i = 0; i < n; ++i)
     stiffnessScale += k.coeff(i, i);
@@ -149,7 +148,7 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
     for (std::size_t b = 0; b < boundary.nodes.size(); ++b) {
       const std::uint32_t node = boundary.nodes[b];
       const double one = 1.0;
-      addPoint({&node, 1}, {&one, 1}, targetTree.closest(mesh.nodes[node]).closest.point, w * nodeArea[b]);
+      addPoint({&node, 1}, {&one, 1}, target.closestPoint(mesh.nodes[node]), w * nodeArea[b]);
     }
     // Target points to their closest boundary points (a face of the current boundary, by barycentric
     // weights).
@@ -161,11 +160,11 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const core::Tr
       return surface;
     }();
     const core::ClosestPointTree currentTree(current);
-    for (std::size_t v = 0; v < target.vertices.size(); v += stride) {
-      const core::ClosestPointTree::Hit hit = currentTree.closest(target.vertices[v]);
+    for (std::size_t v = 0; v < target.vertexCount(); v += stride) {
+      const Vec3 point = target.vertex(v);
+      const core::ClosestPointTree::Hit hit = currentTree.closest(point);
       const auto& t = current.triangles[hit.triangle];
-      addPoint(t, hit.closest.barycentric, target.vertices[v],
-               w * vertexArea[v] * static_cast<double>(stride));
+      addPoint(t, hit.closest.barycentric, point, w * vertexArea[v] * static_cast<double>(stride));
     }
     if (!inPattern) break;  // cannot be: two nodes of a boundary face share its tet
     // Every round's A has K's sparsity: the first round's analysis serves them all.
@@ -203,13 +202,43 @@ double tetQuality(const TetMesh& mesh, std::size_t t) {
   return volume < 0.0 ? -q : q;
 }
 
+Result<MorphTarget> MorphTarget::prepare(core::TriangleMesh surface) {
+  if (Status valid = core::validateMesh(surface); !valid)
+    return Error{ErrorCode::kInvalidArgument,
+                 "morph: the target surface is not valid: " + valid.error().message};
+  MorphTarget out;
+  if (auto mass = core::computeMassProperties(surface)) {
+    out.mMass = *mass;
+    out.mSide = core::SurfaceSide(surface);
+  } else {
+    out.mTree = core::ClosestPointTree(surface);
+  }
+  out.mVertexAreas = core::vertexAreaWeights(surface);
+  out.mSurface = std::move(surface);
+  return out;
+}
+
+Vec3 MorphTarget::View::closestPoint(const Vec3& p) const {
+  return mFrame * mTarget->tree().closest(mFrame.transpose() * p).closest.point;
+}
+
+core::Mat3 MorphTarget::View::covariance() const {
+  return mFrame * volume::covariance(*mTarget->mMass) * mFrame.transpose();
+}
+
 Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& target,
                                  const MorphOptions& options) {
   if (Status valid = core::validateTetMesh(mesh); !valid)
     return Error{ErrorCode::kInvalidArgument, "morph: the tet mesh is not valid: " + valid.error().message};
-  if (Status valid = core::validateMesh(target); !valid)
-    return Error{ErrorCode::kInvalidArgument,
-                 "morph: the target surface is not valid: " + valid.error().message};
+  auto prepared = MorphTarget::prepare(target);
+  if (!prepared) return prepared.error();
+  return morphTetMesh(mesh, prepared->view(), options);
+}
+
+Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& target,
+                                 const MorphOptions& options) {
+  if (Status valid = core::validateTetMesh(mesh); !valid)
+    return Error{ErrorCode::kInvalidArgument, "morph: the tet mesh is not valid: " + valid.error().message};
   if (options.registrationRounds < 0 || options.maxIncrements < 1 ||
       !(options.minQuality > 0.0 && options.minQuality < 1.0))
     return Error{ErrorCode::kInvalidArgument,
@@ -223,10 +252,9 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& 
 
   // The affine part first: the stretch that gives the tets the target's second moments along x, y, z.
   if (options.prestretch) {
-    auto targetMass = core::computeMassProperties(target);
-    if (targetMass) {
+    if (target.target().massProperties()) {
       const core::MassProperties own = core::computeTetMassProperties(mesh);
-      const Vec3 a = (covariance(*targetMass).diagonal().array() / covariance(own).diagonal().array()).sqrt();
+      const Vec3 a = (target.covariance().diagonal().array() / covariance(own).diagonal().array()).sqrt();
       if (a.allFinite() && (a.array() > 0.0).all()) {
         out.report.stretch = a;
         for (Vec3& p : out.mesh.nodes)
@@ -237,16 +265,14 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& 
 
   // Elastic registration, then every boundary node onto its closest target point.
   const Boundary boundary = findBoundary(out.mesh);
-  const core::ClosestPointTree tree(target);
   std::vector<char> isBoundary(out.mesh.nodeCount(), 0);
   for (std::uint32_t node : boundary.nodes)
     isBoundary[node] = 1;
   detail::InteriorMotion motion(out.mesh, isBoundary);
-  registerElastically(out.mesh, boundary, target, tree, options.registrationRounds, minQuality,
-                      motion.stiffness());
+  registerElastically(out.mesh, boundary, target, options.registrationRounds, minQuality, motion.stiffness());
   std::vector<Vec3> p(boundary.nodes.size());
   for (std::size_t i = 0; i < p.size(); ++i)
-    p[i] = tree.closest(out.mesh.nodes[boundary.nodes[i]]).closest.point;
+    p[i] = target.closestPoint(out.mesh.nodes[boundary.nodes[i]]);
   Eigen::VectorXd move(3 * static_cast<Eigen::Index>(p.size()));
   for (std::size_t i = 0; i < p.size(); ++i)
     move.segment<3>(3 * static_cast<Eigen::Index>(i)) = p[i] - out.mesh.nodes[boundary.nodes[i]];
@@ -331,11 +357,11 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& 
   out.report.meanBoundaryMove =
       boundary.nodes.empty() ? 0.0 : sum / static_cast<double>(boundary.nodes.size());
   const core::ClosestPointTree morphed(core::boundarySurface(out.mesh));
-  const std::size_t stride = std::max<std::size_t>(1, target.vertices.size() / 2000);
+  const std::size_t stride = std::max<std::size_t>(1, target.vertexCount() / 2000);
   double distance = 0.0;
   std::size_t count = 0;
-  for (std::size_t v = 0; v < target.vertices.size(); v += stride, ++count)
-    distance += std::sqrt(morphed.closest(target.vertices[v]).closest.squaredDistance);
+  for (std::size_t v = 0; v < target.vertexCount(); v += stride, ++count)
+    distance += std::sqrt(morphed.closest(target.vertex(v)).closest.squaredDistance);
   out.report.meanTargetDistance = distance / static_cast<double>(count);
   return out;
 }

@@ -80,6 +80,8 @@ class SurfaceSide {
   /// The distance from p to the surface, negative inside.
   double signedDistance(const Vec3& p) const;
   bool inside(const Vec3& p) const { return signedDistance(p) < 0.0; }
+  /// The closest-point tree it searches, for other queries on the same surface.
+  const ClosestPointTree& tree() const { return mTree; }
 
  private:
   Vec3 faceNormal(std::uint32_t triangle) const;  ///< unit; 0 for a triangle of zero area

@@ -82,6 +82,20 @@ struct MorphedEntry {
 /// tets), morphTetMesh's (the morph would invert a tet: keep the entry's data).
 Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const core::TriangleMesh& target,
                                 const CorrectionOptions& options = {});
+/// Whether morphEntry places the mass the morphed tets lack (MorphedEntry::pointMasses), or leaves it to
+/// placeMissingMass: a query morphs several candidates and keeps one, and the choice does not need it (it
+/// visits every vertex of the target, the largest part of a morph onto a scan of many triangles).
+enum class MissingMass { kPlaced, kDeferred };
+
+/// The same onto a prepared target, as `target` sees it: a query's candidates share one preparation of
+/// its surface, each through its own orientation. report.morphSeconds leaves the preparation out.
+Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const MorphTarget::View& target,
+                                const CorrectionOptions& options = {},
+                                MissingMass missing = MissingMass::kPlaced);
+
+/// The mass `morphed` (morphEntry onto `target`, with MissingMass::kDeferred) lacks, placed as morphEntry
+/// places it: after this, `morphed` is what morphEntry would have returned.
+void placeMissingMass(MorphedEntry& morphed, const MorphTarget::View& target);
 
 /// The correction's second half: the modes of `morphed` (morphEntry of this `entry`) computed with `modal`
 /// (the database's: count, elements, Poisson ratio; E = ρ = 1 and morphed.pointMasses, or ρ =

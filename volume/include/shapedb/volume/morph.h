@@ -4,8 +4,13 @@
 // onto the query's own surface they have the query's, and modes computed on them are the query's to
 // within what the entry's resolution can hold.
 
+#include <optional>
+#include <vector>
+
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
+#include <shapedb/core/spatial.h>
 #include <shapedb/core/triangle_mesh.h>
 #include <shapedb/core/types.h>
 
@@ -58,6 +63,55 @@ struct MorphResult {
 /// one; negative volumes give negative values.
 double tetQuality(const core::TetMesh& mesh, std::size_t t);
 
+/// A surface to morph onto, prepared once: checked, its closest-point tree and side test built, its mass
+/// properties and vertex areas computed, all in the frame it is given in. A morph sees it through an
+/// orthogonal map into the tet mesh's frame (View): the points the morph asks about are carried into the
+/// target's frame and the answers back, so that one preparation serves every entry a query morphs, each in
+/// its own orientation, where each used to build its own tree over a copy of the surface (the whole cost of
+/// a morph onto a scan of 100,000 triangles). Immutable once prepared: concurrent morphs are safe.
+class MorphTarget {
+ public:
+  /// Errors: kInvalidArgument (the surface fails core::validateMesh).
+  static Result<MorphTarget> prepare(core::TriangleMesh surface);
+
+  const core::TriangleMesh& surface() const { return mSurface; }
+  /// At unit density; empty where the surface bounds no solid (open, or wound inward), which has no
+  /// volume, no moments and no inside.
+  const std::optional<core::MassProperties>& massProperties() const { return mMass; }
+  /// Per vertex, a third of the area of its triangles (core::vertexAreaWeights).
+  const std::vector<double>& vertexAreas() const { return mVertexAreas; }
+
+  /// The target as a mesh in another frame sees it: `frame` (orthogonal) carries a point of the target's
+  /// frame into the mesh's. Holds the target by reference.
+  class View {
+   public:
+    View(const MorphTarget& target, const core::Mat3& frame) : mTarget(&target), mFrame(frame) {}
+    const MorphTarget& target() const { return *mTarget; }
+    std::size_t vertexCount() const { return mTarget->mSurface.vertices.size(); }
+    core::Vec3 vertex(std::size_t v) const { return mFrame * mTarget->mSurface.vertices[v]; }
+    core::Vec3 closestPoint(const core::Vec3& p) const;
+    /// Whether p lies inside the surface. Precondition: massProperties() (the surface bounds a solid).
+    bool inside(const core::Vec3& p) const { return mTarget->mSide.inside(mFrame.transpose() * p); }
+    /// ∫ (x − c)(x − c)ᵀ dV about the centre of mass, in the mesh's frame. Precondition: massProperties().
+    core::Mat3 covariance() const;
+
+   private:
+    const MorphTarget* mTarget;
+    core::Mat3 mFrame;
+  };
+  /// In the target's own frame.
+  View view() const { return View(*this, core::Mat3::Identity()); }
+
+ private:
+  MorphTarget() = default;
+  const core::ClosestPointTree& tree() const { return mMass ? mSide.tree() : mTree; }
+  core::TriangleMesh mSurface;
+  std::optional<core::MassProperties> mMass;
+  std::vector<double> mVertexAreas;
+  core::SurfaceSide mSide;       ///< built where the surface bounds a solid; its tree serves the searches
+  core::ClosestPointTree mTree;  ///< built only where it does not
+};
+
 /// Moves `mesh`'s boundary nodes onto `target` (a closed surface in the same frame and of about the same
 /// size and orientation: a query carried into its matched entry's canonical frame) and its inner nodes
 /// with them: prestretch; elastic registration; then every boundary node onto its closest target point,
@@ -67,6 +121,11 @@ double tetQuality(const core::TetMesh& mesh, std::size_t t);
 /// out of range); kDegenerateFace when no part of the morph keeps every tet above minQuality (the message
 /// gives the quality reached): the caller keeps the unmorphed data.
 Result<MorphResult> morphTetMesh(const core::TetMesh& mesh, const core::TriangleMesh& target,
+                                 const MorphOptions& options = {});
+
+/// The same onto a prepared target, as `target` sees it (the same result as morphing onto a copy of the
+/// target's surface carried into the mesh's frame, to round-off; its test compares the two).
+Result<MorphResult> morphTetMesh(const core::TetMesh& mesh, const MorphTarget::View& target,
                                  const MorphOptions& options = {});
 
 }  // namespace shapedb::volume
