@@ -420,7 +420,7 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     // that reaches the query's surface best.
     std::optional<volume::CorrectedEntry> corrected;
     std::shared_ptr<const core::TetLocator> correctedLocator;
-    std::string correctionWarning;
+    std::vector<std::string> correctionWarnings;
     if (options.correct) {
       t = Clock::now();
       // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
@@ -432,14 +432,9 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
         out.correction = c.corrected->report;
         corrected = std::move(c.corrected);
         correctedLocator = std::make_shared<const core::TetLocator>(corrected->physics.tetMesh);
-        if (out.correction->strayShare > volume::kStrayShareWarning)
-          correctionWarning =
-              "geometry correction: " + std::to_string(std::lround(100 * out.correction->strayShare)) +
-              " % of the morphed tets lie outside the mesh (the entry spans a gap the object "
-              "has, as between limbs or through a loop): the corrected frequencies may be far "
-              "off; the object's own data (enrichment) are the answer for it";
+        correctionWarnings = volume::correctionWarnings(*out.correction);
       } else {
-        correctionWarning = "geometry correction not applied (the entry's own data stand): " + c.error;
+        correctionWarnings = {"geometry correction not applied (the entry's own data stand): " + c.error};
       }
       out.times.correct = microsecondsSince(t);
     }
@@ -457,7 +452,8 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
         parameters().entry.damping, options.stretchCorrection ? &answered.stretchBasis() : nullptr);
     if (!adapted) return adapted.error();
     out.physics = std::move(adapted).value();
-    if (!correctionWarning.empty()) out.physics->warnings.push_back(correctionWarning);
+    out.physics->warnings.insert(out.physics->warnings.end(), correctionWarnings.begin(),
+                                 correctionWarnings.end());
     if (out.massProperties.isApproximate)
       out.physics->warnings.push_back(
           "approximate: the surface bounds no well-defined solid, so its mass, centre and inertia are "

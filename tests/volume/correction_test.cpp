@@ -159,6 +159,25 @@ TEST(Correction, TheBetterMorphReachesTheTargetWithoutStrayingAcrossItsGaps) {
   EXPECT_TRUE(betterMorph(near, far));
 }
 
+// What an answer says of a correction that may be far off: one sentence for tets across a gap, one for a
+// part of the object the tets do not hold, none for a correction within both bounds (or at them).
+TEST(Correction, AnswersWarnOfTetsAcrossAGapAndOfVolumeTheyDoNotHold) {
+  CorrectionReport report;
+  report.strayShare = kStrayShareWarning;
+  report.massScale = kMassScaleWarning;
+  EXPECT_TRUE(correctionWarnings(report).empty());
+  report.strayShare = 0.27;
+  std::vector<std::string> warnings = correctionWarnings(report);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("27 % of the morphed tets lie outside"), std::string::npos) << warnings[0];
+  report.massScale = 1.6;  // the tets hold 62.5 % of the target
+  warnings = correctionWarnings(report);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[1].find("hold 63 % of the mesh's volume"), std::string::npos) << warnings[1];
+  report.strayShare = 0.0;
+  EXPECT_EQ(correctionWarnings(report).size(), 1u);
+}
+
 // The mass the morph misses: an ellipsoid's tets onto a box cut the box's edges and corners. The tets keep
 // their shape; the box's volume they lack is lumped at their boundary nodes, all of it (the answer has the
 // box's mass), none inside, and most of it at the nodes nearest the box's corners and edges, where it is

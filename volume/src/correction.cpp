@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include <shapedb/core/mass_properties.h>
@@ -103,6 +104,22 @@ void placeMissingMass(MorphedEntry& morphed, const MorphTarget::View& target) {
   const double volume = core::computeTetMassProperties(morphed.tetMesh).volume;
   if (std::isfinite(targetMass->volume / volume) && targetMass->volume > volume && volume > 0.0)
     morphed.pointMasses = missingMass(morphed.tetMesh, target, targetMass->volume - volume);
+}
+
+std::vector<std::string> correctionWarnings(const CorrectionReport& report) {
+  std::vector<std::string> out;
+  if (report.strayShare > kStrayShareWarning)
+    out.push_back("geometry correction: " + std::to_string(std::lround(100 * report.strayShare)) +
+                  " % of the morphed tets lie outside the mesh (the entry spans a gap the object has, as "
+                  "between limbs or through a loop): the corrected frequencies may be far off; the object's "
+                  "own data (enrichment) are the answer for it");
+  if (report.massScale > kMassScaleWarning)
+    out.push_back("geometry correction: the morphed tets hold " +
+                  std::to_string(std::lround(100 / report.massScale)) +
+                  " % of the mesh's volume (a part of the object the entry has no tets for): the rest is "
+                  "carried as mass without stiffness, and the corrected frequencies may be far off; the "
+                  "object's own data (enrichment) are the answer for it");
+  return out;
 }
 
 bool betterMorph(const CorrectionReport& a, const CorrectionReport& b) {
