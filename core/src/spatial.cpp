@@ -88,16 +88,17 @@ ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) {
   const auto n = static_cast<std::uint32_t>(surface.triangles.size());
   if (n == 0) return;
   mOrder.resize(n);
-  std::iota(mOrder.begin(), mOrder.end(), 0u);
   {
-    std::vector<Vec3> centroids(n);
+    std::vector<Keyed> items(n);
     for (std::uint32_t t = 0; t < n; ++t) {
       const auto& tri = surface.triangles[t];
-      centroids[t] = (surface.vertices[tri[0]] + surface.vertices[tri[1]] + surface.vertices[tri[2]]) / 3.0;
+      items[t] = {(surface.vertices[tri[0]] + surface.vertices[tri[1]] + surface.vertices[tri[2]]) / 3.0, t};
     }
     std::map<std::uint32_t, std::size_t> memo;
     mNodes.reserve(treeNodeCount(n, memo));
-    build(0, n, surface, centroids);
+    build(0, n, surface, items);
+    for (std::uint32_t i = 0; i < n; ++i)
+      mOrder[i] = items[i].triangle;
   }
   // Triangles in leaf order, so that a leaf's sit next to each other, and the vertices numbered as the
   // leaves first use them, so that a leaf's corners are near each other in memory too.
@@ -129,13 +130,13 @@ TrianglePoint ClosestPointTree::closestOnTriangle(const Vec3& p, std::uint32_t p
 // Splits the triangles mOrder[begin, end) at the median centroid along the centroids' longest extent;
 // boxes are merged bottom-up, so each triangle's corners are read once, at its leaf.
 std::uint32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
-                                      const std::vector<Vec3>& centroids) {
+                                      std::vector<Keyed>& items) {
   const auto index = static_cast<std::uint32_t>(mNodes.size());
   mNodes.emplace_back();
   if (end - begin <= kLeafSize) {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (std::uint32_t i = begin; i < end; ++i)
-      for (std::uint32_t v : surface.triangles[mOrder[i]]) {
+      for (std::uint32_t v : surface.triangles[items[i].triangle]) {
         lo = lo.cwiseMin(surface.vertices[v]);
         hi = hi.cwiseMax(surface.vertices[v]);
       }
@@ -150,16 +151,16 @@ std::uint32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, co
   }
   Vec3 cmin = Vec3::Constant(std::numeric_limits<double>::infinity()), cmax = -cmin;
   for (std::uint32_t i = begin; i < end; ++i) {
-    cmin = cmin.cwiseMin(centroids[mOrder[i]]);
-    cmax = cmax.cwiseMax(centroids[mOrder[i]]);
+    cmin = cmin.cwiseMin(items[i].centroid);
+    cmax = cmax.cwiseMax(items[i].centroid);
   }
   int axis = 0;
   (cmax - cmin).maxCoeff(&axis);
   const std::uint32_t mid = begin + (end - begin) / 2;
-  std::nth_element(mOrder.begin() + begin, mOrder.begin() + mid, mOrder.begin() + end,
-                   [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
-  const std::uint32_t left = build(begin, mid, surface, centroids);
-  const std::uint32_t right = build(mid, end, surface, centroids);
+  std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                   [axis](const Keyed& a, const Keyed& b) { return a.centroid[axis] < b.centroid[axis]; });
+  const std::uint32_t left = build(begin, mid, surface, items);
+  const std::uint32_t right = build(mid, end, surface, items);
   Node& node = mNodes[index];
   node.first = right;
   for (int a = 0; a < 3; ++a) {

@@ -54,8 +54,14 @@ class ClosestPointTree {
     std::uint32_t first = 0;  ///< leaf: its first triangle in mOrder and mTriangles; inner: the right child
     std::uint32_t count = 0;  ///< leaf: how many triangles (≥ 1); inner: 0
   };
+  /// A triangle as the build splits them: its centroid beside its index, so that a split reads the
+  /// centroids in sequence, not through the index.
+  struct Keyed {
+    Vec3 centroid;
+    std::uint32_t triangle;
+  };
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
-                      const std::vector<Vec3>& centroids);
+                      std::vector<Keyed>& items);
   Hit search(const Vec3& p, Hit best, double bestSq) const;
   std::vector<std::uint32_t> mOrder;                     ///< triangle indices, leaves contiguous
   std::vector<std::uint32_t> mPosition;                  ///< inverse of mOrder: where triangle t sits
