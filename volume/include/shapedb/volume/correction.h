@@ -35,7 +35,8 @@ struct CorrectionReport {
   double strayShare = 0.0;
   int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
   /// Entries morphed to choose this one from (a query's candidates, io::QueryOptions::correctionCandidates);
-  /// morphSeconds is all of their morphs'.
+  /// morphSeconds is all of their morphs', with the one preparation of the query's surface they share
+  /// and the chosen one's missing mass.
   int morphs = 1;
   double morphSeconds = 0.0;
   double modesSeconds = 0.0;
