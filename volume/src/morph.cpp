@@ -228,8 +228,6 @@ core::Mat3 MorphTarget::View::covariance() const {
 
 Result<MorphResult> morphTetMesh(const TetMesh& mesh, const core::TriangleMesh& target,
                                  const MorphOptions& options) {
-  if (Status valid = core::validateTetMesh(mesh); !valid)
-    return Error{ErrorCode::kInvalidArgument, "morph: the tet mesh is not valid: " + valid.error().message};
   auto prepared = MorphTarget::prepare(target);
   if (!prepared) return prepared.error();
   return morphTetMesh(mesh, prepared->view(), options);
