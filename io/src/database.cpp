@@ -73,7 +73,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     out.error = target.error().message;
     return out;
   }
-  double morphSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  double morphSeconds = 1e-6 * microsecondsSince(start);
   // The candidates' morphs at once (each its own task: on a free core, the correction waits for the
   // slowest morph rather than for all of them), then chosen in rank order, the better rank among equals.
   std::vector<std::optional<Result<volume::MorphedEntry>>> morphs(candidates);
@@ -99,7 +99,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
   volume::placeMissingMass(*chosen,
                            volume::MorphTarget::View(*target, q.matches[out.answered].match.orientation));
   chosen->report.morphs = static_cast<int>(candidates);
-  chosen->report.morphSeconds = morphSeconds + std::chrono::duration<double>(Clock::now() - placing).count();
+  chosen->report.morphSeconds = morphSeconds + 1e-6 * microsecondsSince(placing);
   auto c = volume::correctMorphed(entries[out.answered]->data, std::move(*chosen), modal);
   if (!c) {
     out.error = c.error().message;
