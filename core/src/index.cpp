@@ -3,6 +3,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -696,9 +697,27 @@ Result<std::vector<Match>> Index::Impl::search(std::span<const Descriptor> candi
   for (std::size_t c = 0; c < candidates.size(); ++c)
     queries.push_back(prepare(candidates[c], static_cast<int>(c), options.momentWeight));
 
+  if (!std::is_sorted(options.among.begin(), options.among.end(), std::less_equal<>()))
+    return Error{ErrorCode::kInvalidArgument,
+                 "the entries to search among must be ascending, without repeats"};
+
   TopK top(k);
   const bool grid = isGrid(mOptions.kind);
-  if (options.method == SearchMethod::kBruteForce) {
+  if (!options.among.empty()) {
+    // Only the entries listed, each against every candidate, as brute force compares them.
+    for (std::size_t slot = 0; slot < size(); ++slot) {
+      if (!std::binary_search(options.among.begin(), options.among.end(), mIds[slot])) continue;
+      for (const Query& q : queries) {
+        ++st.distanceEvaluations;
+        if (!grid) {
+          top.push(momentDistance(q.moments, mMoments[slot]), mIds[slot], q.candidate);
+          continue;
+        }
+        const double moments = momentTerm(q, slot);
+        top.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
+      }
+    }
+  } else if (options.method == SearchMethod::kBruteForce) {
     // The oracle: every entry, its least distance over the candidates.
     const auto scan = [&](const tbb::blocked_range<std::size_t>& range, TopK part) {
       for (std::size_t slot = range.begin(); slot != range.end(); ++slot)

@@ -121,6 +121,57 @@ TEST_P(IndexSmall, PrunedEqualsBruteForce) {
   expectPrunedEqualsBruteForce(GetParam(), 2000, 300);
 }
 
+// A search among some entries of an index answers as brute force over an index of those entries alone,
+// whatever the method asked; an unsorted list is refused.
+TEST_P(IndexSmall, SearchAmongSomeEntriesEqualsAnIndexOfThoseAlone) {
+  const DescriptorKind kind = GetParam();
+  const std::vector<Descriptor> bases = baseDescriptors(kind, 40, 7);
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> flips(0, 10), pickBase(0, 39), pickK(1, 6), pickCandidates(1, 3);
+  const std::vector<Descriptor> entries = jitteredEntries(
+      bases, 600, rng, [&] { return flips(rng); }, 0.15);
+  const Index index = buildIndex(kind, entries);
+  for (int trial = 0; trial < 20; ++trial) {
+    // A random subset, by buildIndex's ids, and one id the index does not hold (ignored).
+    std::vector<EntryId> among;
+    IndexBuilder builder(test::descriptorOptions(kind));
+    const double share = trial % 2 == 0 ? 0.05 : 0.5;
+    for (std::size_t i = 0; i < entries.size(); ++i)
+      if (std::bernoulli_distribution(share)(rng)) {
+        among.push_back(static_cast<EntryId>(1000 + 7 * i));
+        ASSERT_TRUE(builder.add(among.back(), entries[i]).ok());
+      }
+    among.push_back(1);
+    std::sort(among.begin(), among.end());
+    Result<Index> alone = std::move(builder).build();
+    ASSERT_TRUE(alone.ok());
+
+    std::vector<Descriptor> candidates;
+    const Descriptor& base = bases[static_cast<std::size_t>(pickBase(rng))];
+    for (int c = pickCandidates(rng); c > 0; --c)
+      candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
+    SearchOptions options;
+    options.k = pickK(rng);
+    options.momentWeight = trial % 3 == 0 ? 0.0 : 1.0;
+    options.method = SearchMethod::kBruteForce;
+    const std::vector<Match> expected = searchOrDie(*alone, candidates, options);
+    options.among = among;
+    for (SearchMethod method : {SearchMethod::kBruteForce, SearchMethod::kPruned, SearchMethod::kBuckets}) {
+      options.method = method;
+      expectSameMatches(
+          searchOrDie(index, candidates, options), expected,
+          "trial " + std::to_string(trial) + ", method " + std::to_string(static_cast<int>(method)));
+    }
+  }
+  std::vector<EntryId> unsorted = {1007, 1000};
+  SearchOptions options;
+  options.among = unsorted;
+  EXPECT_FALSE(index.search(entries.front(), options).ok());
+  std::vector<EntryId> repeated = {1000, 1000};
+  options.among = repeated;
+  EXPECT_FALSE(index.search(entries.front(), options).ok());
+}
+
 const auto kKinds =
     ::testing::Values(DescriptorKind::kMoment, DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel);
 std::string kindName(const ::testing::TestParamInfo<DescriptorKind>& param) {

@@ -51,6 +51,11 @@ struct SearchOptions {
   /// (w = 1, both terms dimensionless) 4-5 % (docs/architecture.md). 0: the paper's distance alone.
   /// Both terms are ≥ 0, so the grid's lower bounds still bound the sum: the search stays exact.
   double momentWeight = 1.0;
+  /// When not empty, the search considers these entries only (ascending, no repeats; ids the index does
+  /// not hold are ignored): the nearest of one family, say. Each of them is compared in full, whatever
+  /// `method`, so the answer is exact and its cost grows with the index (a pass over every entry's id)
+  /// plus the entries listed.
+  std::span<const EntryId> among = {};
 };
 
 /// What a search did, for benchmarks and tests.
