@@ -113,6 +113,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mass_scale", c.massScale},
           {"stray_share", c.strayShare},
           {"morphs", c.morphs},
+          {"fallback", c.fallback},
           {"solves", c.solves},
           {"morph_seconds", c.morphSeconds},
           {"modes_seconds", c.modesSeconds}};
@@ -171,7 +172,13 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
           "    modes of the entry stretched by %.3f, %.3f, %.3f along its axes (to the mesh's proportions)\n",
           p.stretch.x(), p.stretch.y(), p.stretch.z());
     if (r.correction) {
-      if (r.correction->morphs > 1)
+      if (r.correction->fallback)
+        std::printf(
+            "    corrected from rank %zu, the nearest box entry: the %d best matches' morphs left much of "
+            "the "
+            "mesh unfilled, and a box's fills it\n",
+            r.answered + 1, r.correction->morphs - 1);
+      else if (r.correction->morphs > 1)
         std::printf("    corrected from rank %zu: of the %d best matches' morphs, the one nearest the mesh\n",
                     r.answered + 1, r.correction->morphs);
       const volume::MorphReport& m = r.correction->morph;

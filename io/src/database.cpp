@@ -2,6 +2,7 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <list>
 #include <mutex>
 #include <string_view>
@@ -43,23 +44,33 @@ double microsecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
-/// The geometry correction of a query: the corrected data and the index of the match they are of, or why
-/// there are none.
+/// An entry the correction may turn to beyond the search's matches (QueryOptions::correctionFallback):
+/// its match against the query and its data.
+struct Fallback {
+  core::Match match;
+  std::shared_ptr<const CachedEntry> entry;
+};
+
+/// The geometry correction of a query: the corrected data and the index of the match they are of (or the
+/// fallback whose they are), or why there are none.
 struct Correction {
   std::optional<volume::CorrectedEntry> corrected;
   std::size_t answered = 0;
-  std::string error;  ///< the first failure's, when nothing was corrected
+  std::optional<Fallback> fallback;  ///< set when the fallback answered
+  std::string error;                 ///< the first failure's, when nothing was corrected
 };
 
 /// Morphs the entries of `q`'s first `candidates` matches (`entries`, in match order) onto `mesh`, each
 /// carried into its entry's canonical frame, and computes the modes of the morph that reaches `mesh`'s
 /// surface best (the smallest mean target distance; the first of equals) among those whose tets do not
 /// stray across a gap of it (volume::kStrayShareWarning), if any do not. Candidates whose morph fails
-/// are passed over.
+/// are passed over. Where the chosen morph leaves much of `mesh` unfilled (volume::kMassScaleWarning),
+/// `fallback` (if given) is asked for one more entry, whose morph answers instead if it draws no warning.
 Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryResult& q,
                                   std::span<const std::shared_ptr<const CachedEntry>> entries,
                                   std::size_t candidates, const volume::ModalOptions& modal,
-                                  const volume::CorrectionOptions& options) {
+                                  const volume::CorrectionOptions& options,
+                                  const std::function<std::optional<Fallback>()>& fallback) {
   Correction out;
   // The query's surface in its canonical frame, prepared once (its closest-point tree, side test, moments):
   // each candidate sees it through its own orientation, which carries that frame into the entry's.
@@ -82,28 +93,48 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     morphs[i] = volume::morphEntry(entries[i]->data, view, options, volume::MissingMass::kDeferred);
   });
   std::optional<volume::MorphedEntry> chosen;
+  int morphed = 0;
   for (std::size_t i = 0; i < candidates; ++i) {
-    Result<volume::MorphedEntry>& morphed = *morphs[i];
-    if (!morphed) {
-      if (out.error.empty()) out.error = morphed.error().message;
+    Result<volume::MorphedEntry>& m = *morphs[i];
+    ++morphed;
+    if (!m) {
+      if (out.error.empty()) out.error = m.error().message;
       continue;
     }
-    morphSeconds += morphed->report.morphSeconds;
-    if (!chosen || volume::betterMorph(morphed->report, chosen->report)) {
-      chosen = std::move(morphed).value();
+    morphSeconds += m->report.morphSeconds;
+    if (!chosen || volume::betterMorph(m->report, chosen->report)) {
+      chosen = std::move(m).value();
       out.answered = i;
     }
   }
+  if (chosen && chosen->report.massScale > volume::kMassScaleWarning && fallback) {
+    if (std::optional<Fallback> f = fallback()) {
+      ++morphed;
+      auto m = volume::morphEntry(f->entry->data, volume::MorphTarget::View(*target, f->match.orientation),
+                                  options, volume::MissingMass::kDeferred);
+      if (m) {
+        morphSeconds += m->report.morphSeconds;
+        if (volume::correctionWarnings(m->report).empty()) {
+          chosen = std::move(m).value();
+          out.fallback = std::move(f);
+        }
+      }
+    }
+  }
   if (!chosen) return out;
+  const core::Mat3& orientation =
+      out.fallback ? out.fallback->match.orientation : q.matches[out.answered].match.orientation;
+  const core::PhysicalData& entry = out.fallback ? out.fallback->entry->data : entries[out.answered]->data;
   const Clock::time_point placing = Clock::now();
-  volume::placeMissingMass(*chosen,
-                           volume::MorphTarget::View(*target, q.matches[out.answered].match.orientation));
-  chosen->report.morphs = static_cast<int>(candidates);
+  volume::placeMissingMass(*chosen, volume::MorphTarget::View(*target, orientation));
+  chosen->report.morphs = morphed;
+  chosen->report.fallback = out.fallback.has_value();
   chosen->report.morphSeconds = morphSeconds + 1e-6 * microsecondsSince(placing);
-  auto c = volume::correctMorphed(entries[out.answered]->data, std::move(*chosen), modal);
+  auto c = volume::correctMorphed(entry, std::move(*chosen), modal);
   if (!c) {
     out.error = c.error().message;
     out.answered = 0;
+    out.fallback.reset();
     return out;
   }
   out.corrected = std::move(c).value();
@@ -135,6 +166,7 @@ struct Database::Impl {
   std::vector<EntryRecord> entries;  ///< the file's when opened; never changes
   std::unordered_map<core::EntryId, std::size_t> byId;
   std::unordered_map<std::string_view, std::size_t> byName;
+  std::vector<core::EntryId> boxes;  ///< the box entries' ids, ascending: the correction's fallback
   std::array<std::unique_ptr<core::LiveIndex>, 3> indexes;
 
   // Learned entries: records at stable addresses (a deque only grows at its end), found by id and name
@@ -189,7 +221,9 @@ Result<Database> Database::open(const std::filesystem::path& path, const OpenOpt
     impl->byId.emplace(e.id, i);
     impl->byName.emplace(e.name, i);
     impl->nextId = std::max(impl->nextId, e.id + 1);
+    if (e.family == volume::Family::kBox) impl->boxes.push_back(e.id);
   }
+  std::sort(impl->boxes.begin(), impl->boxes.end());
   if (options.descriptors.empty())
     return Error{ErrorCode::kInvalidArgument, path.string() + ": no descriptor kind to index"};
   for (core::DescriptorKind kind : options.descriptors) {
@@ -426,7 +460,30 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
       volume::ModalOptions modal = parameters().entry.modal;
       modal.material.poissonRatio = options.material.poissonRatio;
-      Correction c = correctAmongCandidates(mesh, out, entries, candidateCount, modal, options.correction);
+      // The fallback: the nearest box entry, unless it was a candidate already.
+      std::function<std::optional<Fallback>()> fallback;
+      if (options.correctionFallback && !mImpl->boxes.empty())
+        fallback = [&]() -> std::optional<Fallback> {
+          core::SearchOptions among = search;
+          among.k = 1;
+          among.among = mImpl->boxes;
+          auto box = index(options.descriptor).search(*candidates, among);
+          if (!box || box->empty()) return std::nullopt;
+          for (std::size_t i = 0; i < candidateCount; ++i)
+            if (out.matches[i].match.entry == box->front().entry) return std::nullopt;
+          auto e = mImpl->cachedEntry(box->front().entry);
+          if (!e) return std::nullopt;
+          return Fallback{box->front(), std::move(e).value()};
+        };
+      Correction c =
+          correctAmongCandidates(mesh, out, entries, candidateCount, modal, options.correction, fallback);
+      if (c.fallback) {
+        // The fallback's match follows the search's; entries keeps matches' indices.
+        entries.resize(out.matches.size());
+        entries.push_back(c.fallback->entry);
+        out.matches.push_back({c.fallback->match, entry(c.fallback->match.entry), std::nullopt});
+        c.answered = out.matches.size() - 1;
+      }
       if (c.corrected) {
         out.answered = c.answered;
         out.correction = c.corrected->report;

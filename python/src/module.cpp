@@ -173,7 +173,7 @@ py::dict correctionDict(const volume::CorrectionReport& r) {
                   "mean_boundary_move"_a = m.meanBoundaryMove,
                   "mean_target_distance"_a = m.meanTargetDistance, "projected"_a = m.projected,
                   "mass_scale"_a = r.massScale, "stray_share"_a = r.strayShare, "solves"_a = r.solves,
-                  "morphs"_a = r.morphs, "morph_seconds"_a = r.morphSeconds,
+                  "morphs"_a = r.morphs, "fallback"_a = r.fallback, "morph_seconds"_a = r.morphSeconds,
                   "modes_seconds"_a = r.modesSeconds);
 }
 

@@ -21,6 +21,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/database.h>
 #include <shapedb/io/store.h>
+#include <shapedb/volume/correction.h>
 #include <shapedb/volume/entry.h>
 #include <shapedb/volume/families.h>
 #include <shapedb/volume/modal.h>
@@ -402,6 +403,7 @@ TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQu
     options.fidelity = false;
     options.correct = true;
     options.correctionCandidates = 3;
+    options.correctionFallback = false;  // the candidates alone: the fallback has its own test
     auto r = db->query(query, options);
     ASSERT_TRUE(r.ok() && r->physics) << e.name << ": " << (r ? "" : r.error().message);
     ASSERT_GE(r->matches.size(), 3u) << e.name;
@@ -466,6 +468,96 @@ TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQu
     EXPECT_EQ(one->correction->morphs, 1);
   }
   EXPECT_GT(checked, 0u);
+}
+
+// A thin plate with two holes (1:50, a tray or a sheet-metal part) against a database of rings and boxes: its
+// nearest entries are rings, whose morphs leave much of it unfilled, so the correction turns to the nearest
+// box, whose morph fills it. Against an oracle of independent morphs, and the same query without the
+// fallback.
+TEST(Database, WhereTheNearestEntriesMorphsLeaveTheQueryUnfilledTheNearestBoxAnswers) {
+  test::ScratchDir dir("fallback");
+  const std::filesystem::path path = dir / "rings-and-boxes.db";
+  auto built = buildDatabase(path, smallBuild(12, {volume::Family::kRing, volume::Family::kBox}));
+  ASSERT_TRUE(built.ok()) << built.error().message;
+  ASSERT_EQ(built->failed, 0u);
+  auto db = Database::open(path);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  volume::ShapeSpec plate;
+  plate.family = volume::Family::kHoled;
+  plate.index = 2;  // holes small enough that a box morphed onto it strays across them by under a tenth
+  plate.params = core::Vec3(1.0, 0.02, 2.0);
+  auto surface = volume::makeFamilyShape(plate, db->parameters().resolution);
+  ASSERT_TRUE(surface.ok()) << surface.error().message;
+  std::mt19937_64 rng(5);
+  const core::TriangleMesh query = core::transformed(*surface, test::randomSimilarity(rng, 2.0, 0.5, 2.0));
+
+  QueryOptions options;
+  options.fidelity = false;
+  options.correct = true;
+  auto r = db->query(query, options);
+  ASSERT_TRUE(r.ok() && r->physics && r->correction) << (r ? "no correction" : r.error().message);
+
+  // The oracle: each of the three candidates morphed on its own (as the other test does), the best of
+  // them chosen by the same rule; it leaves the plate unfilled.
+  const auto morphOnto = [&](const core::Match& match) {
+    const core::Placement placement = core::placementOf(r->normalization, match.orientation);
+    core::TriangleMesh target = query;
+    for (core::Vec3& v : target.vertices)
+      v = placement.toEntry(v);
+    auto entry = db->physics(match.entry);
+    EXPECT_TRUE(entry.ok());
+    return volume::morphEntry(**entry, target, options.correction);
+  };
+  ASSERT_GE(r->matches.size(), 4u);
+  std::optional<volume::MorphedEntry> best;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(db->entry(r->matches[i].match.entry)->family, volume::Family::kRing);
+    auto morphed = morphOnto(r->matches[i].match);
+    if (morphed && (!best || volume::betterMorph(morphed->report, best->report)))
+      best = std::move(morphed).value();
+  }
+  ASSERT_TRUE(best.has_value());
+  EXPECT_GT(best->report.massScale, volume::kMassScaleWarning);
+
+  // The answer: the nearest box, after the search's matches, exactly as a search among the boxes finds it.
+  std::vector<core::EntryId> boxes;
+  for (const EntryRecord& e : db->entries())
+    if (e.family == volume::Family::kBox) boxes.push_back(e.id);
+  core::SearchOptions among;
+  among.among = boxes;
+  auto nearestBox = db->match(query, DescriptorKind::kCentroidVoxel, among);
+  ASSERT_TRUE(nearestBox.ok() && nearestBox->size() == 1);
+  EXPECT_TRUE(r->correction->fallback);
+  EXPECT_EQ(r->correction->morphs, 4);
+  EXPECT_EQ(r->answered, r->matches.size() - 1);
+  EXPECT_EQ(r->answeredMatch().match.entry, nearestBox->front().entry);
+  EXPECT_EQ(r->answeredMatch().match.distance, nearestBox->front().distance);
+  EXPECT_EQ(r->answeredMatch().entry->family, volume::Family::kBox);
+  EXPECT_TRUE(r->physics->warnings.empty()) << r->physics->warnings.front();
+  auto box = morphOnto(nearestBox->front());
+  ASSERT_TRUE(box.ok()) << box.error().message;
+  EXPECT_TRUE(volume::correctionWarnings(box->report).empty());
+  EXPECT_EQ(r->correction->massScale, box->report.massScale);
+  volume::ModalOptions modal = db->parameters().entry.modal;
+  modal.material.poissonRatio = options.material.poissonRatio;
+  auto expected = volume::correctMorphed(**db->physics(nearestBox->front().entry), std::move(*box), modal);
+  ASSERT_TRUE(expected.ok()) << expected.error().message;
+  auto adapted =
+      core::adapt(expected->physics, r->normalization, r->massProperties, nearestBox->front().orientation,
+                  options.material, db->parameters().entry.damping);
+  ASSERT_TRUE(adapted.ok());
+  EXPECT_EQ(r->physics->frequenciesHz(), adapted->frequenciesHz());
+
+  // Without the fallback: the best ring's morph, and the warning that it leaves the plate unfilled.
+  options.correctionFallback = false;
+  auto without = db->query(query, options);
+  ASSERT_TRUE(without.ok() && without->correction);
+  EXPECT_FALSE(without->correction->fallback);
+  EXPECT_LT(without->answered, 3u);
+  EXPECT_EQ(without->correction->massScale, best->report.massScale);
+  ASSERT_FALSE(without->physics->warnings.empty());
+  EXPECT_NE(without->physics->warnings.back().find("hold"), std::string::npos)
+      << without->physics->warnings.back();
 }
 
 // A burst (queryMany) against the oracle of one query at a time: every entry's surface under a random
