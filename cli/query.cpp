@@ -174,10 +174,10 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
     if (r.correction) {
       if (r.correction->fallback)
         std::printf(
-            "    corrected from rank %zu, the nearest box entry: the %d best matches' morphs left much of "
-            "the "
-            "mesh unfilled, and a box's fills it\n",
-            r.answered + 1, r.correction->morphs - 1);
+            "    corrected from rank %zu, a fallback: the nearest matches' morphs left much of the mesh "
+            "unfilled, and this entry's (nearest by shape alone, or the nearest box) fills it (%d "
+            "morphs)\n",
+            r.answered + 1, r.correction->morphs);
       else if (r.correction->morphs > 1)
         std::printf("    corrected from rank %zu: of the %d best matches' morphs, the one nearest the mesh\n",
                     r.answered + 1, r.correction->morphs);

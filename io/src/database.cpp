@@ -44,6 +44,9 @@ double microsecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
+/// The entries nearest by shape alone that a correction's fallback morphs (QueryOptions::correctionFallback).
+constexpr std::size_t kShapeFallbacks = 3;
+
 /// An entry the correction may turn to beyond the search's matches (QueryOptions::correctionFallback):
 /// its match against the query and its data.
 struct Fallback {
@@ -65,12 +68,13 @@ struct Correction {
 /// surface best (the smallest mean target distance; the first of equals) among those whose tets do not
 /// stray across a gap of it (volume::kStrayShareWarning), if any do not. Candidates whose morph fails
 /// are passed over. Where the chosen morph leaves much of `mesh` unfilled (volume::kMassScaleWarning),
-/// `fallback` (if given) is asked for one more entry, whose morph answers instead if it draws no warning.
+/// `fallback` (if given) is asked for more entries: the best of their morphs that draw no warning answers
+/// instead.
 Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryResult& q,
                                   std::span<const std::shared_ptr<const CachedEntry>> entries,
                                   std::size_t candidates, const volume::ModalOptions& modal,
                                   const volume::CorrectionOptions& options,
-                                  const std::function<std::optional<Fallback>()>& fallback) {
+                                  const std::function<std::vector<Fallback>()>& fallback) {
   Correction out;
   // The query's surface in its canonical frame, prepared once (its closest-point tree, side test, moments):
   // each candidate sees it through its own orientation, which carries that frame into the entry's.
@@ -108,16 +112,23 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     }
   }
   if (chosen && chosen->report.massScale > volume::kMassScaleWarning && fallback) {
-    if (std::optional<Fallback> f = fallback()) {
+    // The fallback entries' morphs at once; the best of those that draw no warning answers instead.
+    std::vector<Fallback> more = fallback();
+    std::vector<std::optional<Result<volume::MorphedEntry>>> extra(more.size());
+    tbb::parallel_for(std::size_t{0}, more.size(), [&](std::size_t i) {
+      extra[i] = volume::morphEntry(more[i].entry->data,
+                                    volume::MorphTarget::View(*target, more[i].match.orientation), options,
+                                    volume::MissingMass::kDeferred);
+    });
+    for (std::size_t i = 0; i < more.size(); ++i) {
+      Result<volume::MorphedEntry>& m = *extra[i];
       ++morphed;
-      auto m = volume::morphEntry(f->entry->data, volume::MorphTarget::View(*target, f->match.orientation),
-                                  options, volume::MissingMass::kDeferred);
-      if (m) {
-        morphSeconds += m->report.morphSeconds;
-        if (volume::correctionWarnings(m->report).empty()) {
-          chosen = std::move(m).value();
-          out.fallback = std::move(f);
-        }
+      if (!m) continue;
+      morphSeconds += m->report.morphSeconds;
+      if (!volume::correctionWarnings(m->report).empty()) continue;
+      if (!out.fallback || volume::betterMorph(m->report, chosen->report)) {
+        chosen = std::move(m).value();
+        out.fallback = std::move(more[i]);
       }
     }
   }
@@ -460,20 +471,34 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       // The modes are computed again anyway: with the material's own Poisson ratio (validated above).
       volume::ModalOptions modal = parameters().entry.modal;
       modal.material.poissonRatio = options.material.poissonRatio;
-      // The fallback: the nearest box entry, unless it was a candidate already.
-      std::function<std::optional<Fallback>()> fallback;
-      if (options.correctionFallback && !mImpl->boxes.empty())
-        fallback = [&]() -> std::optional<Fallback> {
-          core::SearchOptions among = search;
-          among.k = 1;
-          among.among = mImpl->boxes;
-          auto box = index(options.descriptor).search(*candidates, among);
-          if (!box || box->empty()) return std::nullopt;
+      // The fallback: the three nearest entries by shape alone (no moment term: the morph's prestretch
+      // gives the query's proportions) and the nearest box, each unless it was morphed already.
+      std::function<std::vector<Fallback>()> fallback;
+      if (options.correctionFallback)
+        fallback = [&] {
+          std::vector<core::EntryId> seen;
           for (std::size_t i = 0; i < candidateCount; ++i)
-            if (out.matches[i].match.entry == box->front().entry) return std::nullopt;
-          auto e = mImpl->cachedEntry(box->front().entry);
-          if (!e) return std::nullopt;
-          return Fallback{box->front(), std::move(e).value()};
+            seen.push_back(out.matches[i].match.entry);
+          std::vector<Fallback> more;
+          const auto take = [&](const core::Match& m) {
+            if (std::find(seen.begin(), seen.end(), m.entry) != seen.end()) return;
+            seen.push_back(m.entry);
+            if (auto e = mImpl->cachedEntry(m.entry)) more.push_back({m, std::move(e).value()});
+          };
+          core::SearchOptions shape = search;
+          shape.k = static_cast<int>(candidateCount + kShapeFallbacks);
+          shape.momentWeight = 0.0;
+          if (auto found = index(options.descriptor).search(*candidates, shape))
+            for (const core::Match& m : *found)
+              if (more.size() < kShapeFallbacks) take(m);
+          if (!mImpl->boxes.empty()) {
+            core::SearchOptions box = search;
+            box.k = 1;
+            box.among = mImpl->boxes;
+            if (auto found = index(options.descriptor).search(*candidates, box); found && !found->empty())
+              take(found->front());
+          }
+          return more;
         };
       Correction c =
           correctAmongCandidates(mesh, out, entries, candidateCount, modal, options.correction, fallback);

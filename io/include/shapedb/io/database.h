@@ -66,11 +66,13 @@ struct QueryOptions {
   int correctionCandidates = 3;
   /// With correct: where the best of the candidates' morphs leaves much of the query unfilled (its mass
   /// scale over volume::kMassScaleWarning: a part of the object that entry has no tets for, such as a
-  /// thin plate's expanse around a ring's rim), the nearest box entry of the database is morphed too,
-  /// and answers instead if its morph draws no warning (fills the query, strays across no gap). A box
-  /// fills the hull of any object it is morphed onto, so it reaches what the nearest shapes lack; it
-  /// spans every gap, so it is not tried where the candidates stray. Its match then follows the search's
-  /// k best in QueryResult::matches. One more morph, on those queries only.
+  /// thin plate's expanse around a ring's rim), more entries are morphed: the three nearest by shape
+  /// alone (the descriptor without its moment term, since the morph's prestretch gives the query's
+  /// proportions) and the nearest box entry (a box fills the hull of any object), each unless it was a
+  /// candidate already. The best of their morphs that draw no warning (fill the query, stray across no
+  /// gap) answers instead; if none does, the candidates' answer and its warning stand. Its match then
+  /// follows the search's k best in QueryResult::matches (a shape-alone match's distance has no moment
+  /// term). Up to four more morphs, on those queries only.
   bool correctionFallback = true;
   bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
   core::FidelityOptions fidelityOptions;
@@ -109,8 +111,8 @@ struct QueryResult {
   core::Normalization normalization;
   std::vector<MatchReport> matches;
   /// The index in matches of the match whose data the answer carries: 0, unless the geometry correction
-  /// chose another of its candidates (QueryOptions::correctionCandidates), or its fallback, the nearest
-  /// box entry, added after the search's matches (QueryOptions::correctionFallback).
+  /// chose another of its candidates (QueryOptions::correctionCandidates), or one of its fallback entries,
+  /// added after the search's matches (QueryOptions::correctionFallback).
   std::size_t answered = 0;
   const MatchReport& answeredMatch() const { return matches[answered]; }
   std::shared_ptr<const core::PhysicalData> entryPhysics;  ///< the answered match's, canonical frame

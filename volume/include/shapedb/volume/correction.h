@@ -38,8 +38,9 @@ struct CorrectionReport {
   /// morphSeconds is all of their morphs', with the one preparation of the query's surface they share
   /// and the chosen one's missing mass.
   int morphs = 1;
-  /// The entry morphed is a query's fallback (io::QueryOptions::correctionFallback), tried because the
-  /// nearest matches' morphs left much of the query unfilled, not one of those matches.
+  /// The entry morphed is one of a query's fallback entries (io::QueryOptions::correctionFallback), tried
+  /// because the nearest matches' morphs left much of the query unfilled, not one of those matches;
+  /// `morphs` counts them too.
   bool fallback = false;
   double morphSeconds = 0.0;
   double modesSeconds = 0.0;
