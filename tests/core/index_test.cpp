@@ -41,6 +41,17 @@ std::vector<Descriptor> jitteredEntries(const std::vector<Descriptor>& bases, in
   return entries;
 }
 
+// A query: one to three orientation candidates, each a jittered copy of one random base.
+std::vector<Descriptor> queryCandidates(const std::vector<Descriptor>& bases, std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> flips(0, 10), pickCandidates(1, 3);
+  std::uniform_int_distribution<std::size_t> pickBase(0, bases.size() - 1);
+  const Descriptor& base = bases[pickBase(rng)];
+  std::vector<Descriptor> candidates;
+  for (int c = pickCandidates(rng); c > 0; --c)
+    candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
+  return candidates;
+}
+
 Index buildIndex(DescriptorKind kind, const std::vector<Descriptor>& entries) {
   IndexBuilder builder(test::descriptorOptions(kind));
   for (std::size_t i = 0; i < entries.size(); ++i)
@@ -71,7 +82,7 @@ void expectSameMatches(const std::vector<Match>& a, const std::vector<Match>& b,
 void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queries) {
   const std::vector<Descriptor> bases = baseDescriptors(kind, 150, 42);
   std::mt19937_64 rng(99);
-  std::uniform_int_distribution<int> flips(0, 10), pickBase(0, 149), pickK(1, 10), pickCandidates(1, 3);
+  std::uniform_int_distribution<int> flips(0, 10), pickK(1, 10);
   const std::vector<Descriptor> entries = jitteredEntries(
       bases, entryCount, rng, [&] { return flips(rng); }, 0.15);
   const Index index = buildIndex(kind, entries);
@@ -79,10 +90,7 @@ void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queri
 
   SearchStats pruned, brute;
   for (int q = 0; q < queries; ++q) {
-    std::vector<Descriptor> candidates;
-    const Descriptor& base = bases[static_cast<std::size_t>(pickBase(rng))];
-    for (int c = pickCandidates(rng); c > 0; --c)
-      candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
+    const std::vector<Descriptor> candidates = queryCandidates(bases, rng);
     SearchOptions options;
     options.k = pickK(rng);
     options.momentWeight = q % 3 == 0 ? 0.0 : q % 3 == 1 ? 1.0 : 5.0;  // the paper's distance, ours, more
@@ -127,7 +135,7 @@ TEST_P(IndexSmall, SearchAmongSomeEntriesEqualsAnIndexOfThoseAlone) {
   const DescriptorKind kind = GetParam();
   const std::vector<Descriptor> bases = baseDescriptors(kind, 40, 7);
   std::mt19937_64 rng(11);
-  std::uniform_int_distribution<int> flips(0, 10), pickBase(0, 39), pickK(1, 6), pickCandidates(1, 3);
+  std::uniform_int_distribution<int> flips(0, 10), pickK(1, 6);
   const std::vector<Descriptor> entries = jitteredEntries(
       bases, 600, rng, [&] { return flips(rng); }, 0.15);
   const Index index = buildIndex(kind, entries);
@@ -146,10 +154,7 @@ TEST_P(IndexSmall, SearchAmongSomeEntriesEqualsAnIndexOfThoseAlone) {
     Result<Index> alone = std::move(builder).build();
     ASSERT_TRUE(alone.ok());
 
-    std::vector<Descriptor> candidates;
-    const Descriptor& base = bases[static_cast<std::size_t>(pickBase(rng))];
-    for (int c = pickCandidates(rng); c > 0; --c)
-      candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
+    const std::vector<Descriptor> candidates = queryCandidates(bases, rng);
     SearchOptions options;
     options.k = pickK(rng);
     options.momentWeight = trial % 3 == 0 ? 0.0 : 1.0;
