@@ -146,7 +146,9 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
     if (m.fidelity)
       std::printf(" %12s %12s %12s", percent(m.fidelity->maxMomentError).c_str(),
                   percent(m.fidelity->meanDeviation).c_str(), percent(m.fidelity->maxDeviation).c_str());
-    std::printf("\n");
+    // The correction's fallback follows the search's matches, found by a search of its own.
+    const bool fallback = r.correction && r.correction->fallback && i + 1 == r.matches.size();
+    std::printf("%s\n", fallback ? "  (the correction's fallback)" : "");
   }
   if (r.physics) {
     const core::AdaptedPhysics& p = *r.physics;
