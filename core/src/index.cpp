@@ -248,6 +248,7 @@ struct Index::Impl {
   double countBound(const Query& q, std::uint32_t count) const;
   double mismatchDistance(std::uint32_t exclusive, std::uint32_t total) const;
   void searchGridPruned(const Query& q, TopK& top, SearchStats& stats, bool parallel) const;
+  void compareInFull(const Query& q, std::size_t slot, TopK& top) const;
   void searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const;
   void searchMomentTree(const Vec3& q, int candidate, TopK& top, SearchStats& stats) const;
 
@@ -639,6 +640,16 @@ void Index::Impl::searchGridPruned(const Query& q, TopK& top, SearchStats& stats
   stats.distanceEvaluations += found.stats.distanceEvaluations;
 }
 
+// The entry in `slot` against the query, its whole distance with no bound to stop it, offered to `top`.
+void Index::Impl::compareInFull(const Query& q, std::size_t slot, TopK& top) const {
+  if (!isGrid(mOptions.kind)) {
+    top.push(momentDistance(q.moments, mMoments[slot]), mIds[slot], q.candidate);
+    return;
+  }
+  const double moments = momentTerm(q, slot);
+  top.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
+}
+
 // Paper §5: only the entries whose filled-cell count is within ±r of the query's, all compared.
 void Index::Impl::searchGridBuckets(const Query& q, int radius, TopK& top, SearchStats& stats) const {
   const auto maxCount = static_cast<std::int64_t>(mBucketBegin.size()) - 2;
@@ -648,8 +659,7 @@ void Index::Impl::searchGridBuckets(const Query& q, int radius, TopK& top, Searc
     for (std::size_t slot = mBucketBegin[static_cast<std::size_t>(c)];
          slot < mBucketBegin[static_cast<std::size_t>(c) + 1]; ++slot) {
       ++stats.distanceEvaluations;
-      const double moments = momentTerm(q, slot);
-      top.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
+      compareInFull(q, slot, top);
     }
 }
 
@@ -709,26 +719,15 @@ Result<std::vector<Match>> Index::Impl::search(std::span<const Descriptor> candi
       if (!std::binary_search(options.among.begin(), options.among.end(), mIds[slot])) continue;
       for (const Query& q : queries) {
         ++st.distanceEvaluations;
-        if (!grid) {
-          top.push(momentDistance(q.moments, mMoments[slot]), mIds[slot], q.candidate);
-          continue;
-        }
-        const double moments = momentTerm(q, slot);
-        top.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
+        compareInFull(q, slot, top);
       }
     }
   } else if (options.method == SearchMethod::kBruteForce) {
     // The oracle: every entry, its least distance over the candidates.
     const auto scan = [&](const tbb::blocked_range<std::size_t>& range, TopK part) {
       for (std::size_t slot = range.begin(); slot != range.end(); ++slot)
-        for (const Query& q : queries) {
-          if (!grid) {
-            part.push(momentDistance(q.moments, mMoments[slot]), mIds[slot], q.candidate);
-            continue;
-          }
-          const double moments = momentTerm(q, slot);
-          part.push(gridDistance(q, slot, kInfinity, moments), mIds[slot], q.candidate, moments);
-        }
+        for (const Query& q : queries)
+          compareInFull(q, slot, part);
       return part;
     };
     const tbb::blocked_range<std::size_t> all(0, size(), 1024);
