@@ -97,10 +97,9 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     morphs[i] = volume::morphEntry(entries[i]->data, view, options, volume::MissingMass::kDeferred);
   });
   std::optional<volume::MorphedEntry> chosen;
-  int morphed = 0;
+  std::size_t fallbacksMorphed = 0;
   for (std::size_t i = 0; i < candidates; ++i) {
     Result<volume::MorphedEntry>& m = *morphs[i];
-    ++morphed;
     if (!m) {
       if (out.error.empty()) out.error = m.error().message;
       continue;
@@ -114,6 +113,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
   if (chosen && chosen->report.massScale > volume::kMassScaleWarning && fallback) {
     // The fallback entries' morphs at once; the best of those that draw no warning answers instead.
     std::vector<Fallback> more = fallback();
+    fallbacksMorphed = more.size();
     std::vector<std::optional<Result<volume::MorphedEntry>>> extra(more.size());
     tbb::parallel_for(std::size_t{0}, more.size(), [&](std::size_t i) {
       extra[i] = volume::morphEntry(more[i].entry->data,
@@ -122,7 +122,6 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     });
     for (std::size_t i = 0; i < more.size(); ++i) {
       Result<volume::MorphedEntry>& m = *extra[i];
-      ++morphed;
       if (!m) continue;
       morphSeconds += m->report.morphSeconds;
       if (!volume::correctionWarnings(m->report).empty()) continue;
@@ -138,7 +137,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
   const core::PhysicalData& entry = out.fallback ? out.fallback->entry->data : entries[out.answered]->data;
   const Clock::time_point placing = Clock::now();
   volume::placeMissingMass(*chosen, volume::MorphTarget::View(*target, orientation));
-  chosen->report.morphs = morphed;
+  chosen->report.morphs = static_cast<int>(candidates + fallbacksMorphed);
   chosen->report.fallback = out.fallback.has_value();
   chosen->report.morphSeconds = morphSeconds + 1e-6 * microsecondsSince(placing);
   auto c = volume::correctMorphed(entry, std::move(*chosen), modal);
