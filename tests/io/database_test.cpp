@@ -113,6 +113,21 @@ bool turnsSampled(const core::TriangleMesh& surface) {
   return frame->isDegenerate() && frame->planeSymmetry == 0;
 }
 
+/// `match`'s entry morphed on its own onto `query`, carried into the entry's canonical frame as the
+/// query `r` placed it: what Database::query's correction does for one of its entries.
+Result<volume::MorphedEntry> morphOntoQuery(const Database& db, const QueryResult& r,
+                                            const core::TriangleMesh& query, const core::Match& match,
+                                            const volume::CorrectionOptions& options) {
+  const core::Placement placement = core::placementOf(r.normalization, match.orientation);
+  core::TriangleMesh target = query;
+  for (core::Vec3& v : target.vertices)
+    v = placement.toEntry(v);
+  auto entry = db.physics(match.entry);
+  EXPECT_TRUE(entry.ok()) << "entry " << match.entry << ": " << (entry ? "" : entry.error().message);
+  if (!entry) return entry.error();
+  return volume::morphEntry(**entry, target, options);
+}
+
 /// One database for the suite: kPerFamily entries of each generated family. A build that fails fails every
 /// test (an assertion in SetUpTestSuite would make GoogleTest skip them, and ctest report them as skipped).
 class SmallDatabase : public ::testing::Test {
@@ -414,13 +429,7 @@ TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQu
     std::optional<volume::MorphedEntry> best;
     std::size_t bestIndex = 0;
     for (std::size_t i = 0; i < 3; ++i) {
-      const core::Placement placement = core::placementOf(r->normalization, r->matches[i].match.orientation);
-      core::TriangleMesh target = query;
-      for (core::Vec3& v : target.vertices)
-        v = placement.toEntry(v);
-      auto entry = db->physics(r->matches[i].match.entry);
-      ASSERT_TRUE(entry.ok());
-      auto morphed = volume::morphEntry(**entry, target, options.correction);
+      auto morphed = morphOntoQuery(*db, *r, query, r->matches[i].match, options.correction);
       if (morphed &&
           (!best || morphed->report.morph.meanTargetDistance < best->report.morph.meanTargetDistance)) {
         best = std::move(morphed).value();
@@ -511,13 +520,9 @@ TEST(Database, WhereTheNearestEntriesMorphsLeaveTheQueryUnfilledTheFallbackAnswe
           << name << ": " << (r ? "no correction" : r.error().message);
       modal.material.poissonRatio = options.material.poissonRatio;
 
-      // Each entry morphed on its own, onto the query carried into its frame (as the other test does).
+      // Each entry morphed on its own, onto the query carried into its frame.
       const auto morphOnto = [&](const core::Match& match) {
-        const core::Placement placement = core::placementOf(r->normalization, match.orientation);
-        core::TriangleMesh target = query;
-        for (core::Vec3& v : target.vertices)
-          v = placement.toEntry(v);
-        return volume::morphEntry(**db->physics(match.entry), target, options.correction);
+        return morphOntoQuery(*db, *r, query, match, options.correction);
       };
       std::optional<volume::MorphedEntry> best;
       std::vector<core::EntryId> seen;
