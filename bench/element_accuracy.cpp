@@ -4,8 +4,8 @@
 // elements. Prints one row per entry and a table per family (median and worst relative error over the five
 // frequencies), with the mean wall time of an entry's tetrahedralization and modes at the build's meshing.
 //   build/release/bin/element_accuracy [--per-family N] [--elements linear|quadratic]
-//       [--quality Q] [--volume-fraction F] [--segments S] [--stacks T] [--modes M] [--families LIST]
-//       [--csv FILE]
+//       [--quality Q] [--volume-fraction F] [--segments S] [--stacks T] [--stone-subdivisions K]
+//       [--modes M] [--families LIST] [--csv FILE]
 // Defaults: 6 entries per family spread over the default catalog's sweep, the default build's elements and
 // TetGen bounds, 20 modes (the time a build pays), the default families.
 
@@ -71,6 +71,8 @@ int main(int argc, char** argv) {
       resolution.segments = std::atoi(argv[++i]);
     } else if (arg == "--stacks" && value) {
       resolution.stacks = std::atoi(argv[++i]);
+    } else if (arg == "--stone-subdivisions" && value) {
+      resolution.stoneSubdivisions = std::atoi(argv[++i]);
     } else if (arg == "--modes" && value) {
       modes = std::atoi(argv[++i]);
     } else if (arg == "--families" && value) {
@@ -82,8 +84,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: %s [--per-family N] [--elements linear|quadratic] [--quality Q]\n"
-                   "       [--volume-fraction F] [--segments S] [--stacks T] [--modes M]\n"
-                   "       [--families LIST] [--csv FILE]\n",
+                   "       [--volume-fraction F] [--segments S] [--stacks T] [--stone-subdivisions K]\n"
+                   "       [--modes M] [--families LIST] [--csv FILE]\n",
                    argv[0]);
       return 2;
     }

@@ -111,8 +111,9 @@ volume::StageTimes timesFromJson(const json& j) {
 }  // namespace
 
 volume::ShapeResolution entryResolution(volume::ElementOrder order) {
-  return order == volume::ElementOrder::kQuadratic ? volume::ShapeResolution{.segments = 12, .stacks = 6}
-                                                   : volume::ShapeResolution{.segments = 24, .stacks = 12};
+  return order == volume::ElementOrder::kQuadratic
+             ? volume::ShapeResolution{.segments = 12, .stacks = 6, .stoneSubdivisions = 2}
+             : volume::ShapeResolution{.segments = 24, .stacks = 12, .stoneSubdivisions = 2};
 }
 
 BuildParameters withElements(BuildParameters parameters, volume::ElementOrder order) {
@@ -130,7 +131,10 @@ std::string toJson(const BuildParameters& p) {
       {"entries", p.entries},
       {"families", families},
       {"weights", p.weights},
-      {"resolution", {{"segments", p.resolution.segments}, {"stacks", p.resolution.stacks}}},
+      {"resolution",
+       {{"segments", p.resolution.segments},
+        {"stacks", p.resolution.stacks},
+        {"stone_subdivisions", p.resolution.stoneSubdivisions}}},
       {"descriptor",
        {{"grid", e.descriptor.gridSize},
         {"sampling", core::toString(e.descriptor.sampling)},
@@ -171,6 +175,10 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
     }
     p.resolution.segments = j.at("resolution").at("segments").get<int>();
     p.resolution.stacks = j.at("resolution").at("stacks").get<int>();
+    // Files from before the stones' subdivisions were stored made them from 320 triangles.
+    p.resolution.stoneSubdivisions = j.at("resolution").value("stone_subdivisions", 2);
+    if (p.resolution.stoneSubdivisions < 1 || p.resolution.stoneSubdivisions > 4)
+      return Error{ErrorCode::kParse, "the build parameters' stone subdivisions must be 1 to 4"};
     volume::EntryOptions& e = p.entry;
     e.descriptor.gridSize = j.at("descriptor").at("grid").get<int>();
     const auto sampling = core::parseSampling(j.at("descriptor").at("sampling").get<std::string>());

@@ -715,6 +715,27 @@ TEST(BuildParametersJson, ElementOrderRoundTripsAndOlderFilesAreLinear) {
   EXPECT_NE(back.error().message.find("element order"), std::string::npos) << back.error().message;
 }
 
+TEST(BuildParametersJson, StoneSubdivisionsRoundTripAndOlderFilesHaveTwo) {
+  BuildParameters quadratic = withElements(BuildParameters{}, volume::ElementOrder::kQuadratic);
+  quadratic.families = {volume::Family::kStone};
+  quadratic.resolution.stoneSubdivisions = 1;
+  Result<BuildParameters> back = parseBuildParameters(toJson(quadratic));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->resolution.stoneSubdivisions, 1);
+
+  // A file written before the subdivisions were stored made its stones from 320 triangles: a resumed
+  // build of it makes the rest the same way.
+  nlohmann::json older = nlohmann::json::parse(toJson(quadratic));
+  older["resolution"].erase("stone_subdivisions");
+  back = parseBuildParameters(older.dump());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->resolution.stoneSubdivisions, 2);
+  older["resolution"]["stone_subdivisions"] = 9;
+  back = parseBuildParameters(older.dump());
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().message.find("stone subdivisions"), std::string::npos) << back.error().message;
+}
+
 TEST(BuildParametersJson, FamilyWeightsRoundTripAndOlderFilesAreEven) {
   BuildParameters weighted;
   weighted.families = {volume::Family::kBox, volume::Family::kFragment};

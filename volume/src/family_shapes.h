@@ -39,8 +39,10 @@ core::TriangleMesh makeBeamShape(BeamSection section, double thickness, double h
 
 /// A lumpy stone: the ellipsoid of semi-axes (1, a, b) with its radius modulated by random low-order
 /// waves of relative amplitude at most `amplitude` < 0.5, drawn from `rng`; star-shaped about its centre
-/// by construction (a positive radius along every direction).
-core::TriangleMesh makeStoneShape(double a, double b, double amplitude, std::mt19937_64& rng);
+/// by construction (a positive radius along every direction). Its vertices are those of an icosahedron
+/// subdivided `subdivisions` times (20 · 4^subdivisions triangles).
+core::TriangleMesh makeStoneShape(double a, double b, double amplitude, int subdivisions,
+                                  std::mt19937_64& rng);
 
 /// The kinds of the shell family.
 enum class ShellKind { kCup, kBowl, kTube, kOpenBox };

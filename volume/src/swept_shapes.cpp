@@ -404,7 +404,7 @@ TriangleMesh makeBeamShape(BeamSection section, double thickness, double height,
   return mesh;
 }
 
-TriangleMesh makeStoneShape(double a, double b, double amplitude, std::mt19937_64& rng) {
+TriangleMesh makeStoneShape(double a, double b, double amplitude, int subdivisions, std::mt19937_64& rng) {
   // r(d) = 1 + Σ aₖ sin(fₖ d·nₖ + φₖ) over six waves of random direction, frequency and phase, their
   // amplitudes summing to `amplitude`: a smooth radius that never falls below 1 − amplitude.
   constexpr int kWaves = 6;
@@ -420,7 +420,7 @@ TriangleMesh makeStoneShape(double a, double b, double amplitude, std::mt19937_6
     weights[k] = 0.2 + unit(rng);
     total += weights[k];
   }
-  TriangleMesh mesh = core::makeIcosphere(1.0, 2);
+  TriangleMesh mesh = core::makeIcosphere(1.0, subdivisions);
   for (Vec3& p : mesh.vertices) {
     const Vec3 d = p.normalized();
     double r = 1.0;

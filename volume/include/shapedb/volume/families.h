@@ -107,7 +107,8 @@ std::string toString(const FamilyMix& mix);
 /// - limbed (animals, figures): an ellipsoidal body of half-length 1 with n ∈ [2, 6] limbs of length
 ///   l ∈ [0.5, 1.8] (uniform) and radius r ∈ [0.09, 0.22], maybe a head and ears; params (n, l, r);
 /// - stone (lumpy stones): an ellipsoid (1, a, b), 1 ≥ a ≥ b ≥ 0.3, a ≥ 0.45, its radius modulated by
-///   smooth random waves of total amplitude m ∈ [0.08, 0.3] (uniform); params (a, b, m);
+///   smooth random waves of total amplitude m ∈ [0.08, 0.3] (uniform), on a subdivided icosahedron
+///   (ShapeResolution::stoneSubdivisions); params (a, b, m);
 /// - union (unions of primitives): n ∈ [2, 4] boxes, ellipsoids, cylinders and capsules of random
 ///   proportions, orientations and overlaps; params (n, 0, 0).
 /// The drawn details (hole positions, limb placement, waves, primitives) come from the index's stream.
@@ -135,6 +136,10 @@ struct ShapeResolution {
   int stacks = 12;    ///< pole to pole (ellipsoid); capsule caps get half each
   /// Triangles of the families made from level sets (limbed, union) per segment.
   int trianglesPerSegment = 20;
+  /// Subdivisions of the icosahedron a stone is made from (1: 80 triangles; 2: 320; each level four
+  /// times the last), in [1, 4]. Its waves are smooth, and 80 triangles keep a stone's frequencies within
+  /// 1 % of its meshing three times finer for half the tets of 320 (docs/accuracy.md).
+  int stoneSubdivisions = 2;
 };
 
 /// The closed, outward-oriented surface mesh of a spec: one connected solid, which TetGen meshes.
