@@ -112,7 +112,7 @@ volume::StageTimes timesFromJson(const json& j) {
 
 volume::ShapeResolution entryResolution(volume::ElementOrder order) {
   return order == volume::ElementOrder::kQuadratic
-             ? volume::ShapeResolution{.segments = 12, .stacks = 6, .stoneSubdivisions = 2}
+             ? volume::ShapeResolution{.segments = 12, .stacks = 6, .stoneSubdivisions = 1}
              : volume::ShapeResolution{.segments = 24, .stacks = 12, .stoneSubdivisions = 2};
 }
 

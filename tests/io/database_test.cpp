@@ -718,7 +718,8 @@ TEST(BuildParametersJson, ElementOrderRoundTripsAndOlderFilesAreLinear) {
 TEST(BuildParametersJson, StoneSubdivisionsRoundTripAndOlderFilesHaveTwo) {
   BuildParameters quadratic = withElements(BuildParameters{}, volume::ElementOrder::kQuadratic);
   quadratic.families = {volume::Family::kStone};
-  quadratic.resolution.stoneSubdivisions = 1;
+  EXPECT_EQ(quadratic.resolution.stoneSubdivisions, 1);
+  EXPECT_EQ(withElements(quadratic, volume::ElementOrder::kLinear).resolution.stoneSubdivisions, 2);
   Result<BuildParameters> back = parseBuildParameters(toJson(quadratic));
   ASSERT_TRUE(back.ok()) << back.error().message;
   EXPECT_EQ(back->resolution.stoneSubdivisions, 1);
