@@ -47,8 +47,10 @@ Status validateParameters(const BuildParameters& p) {
     return Error{ErrorCode::kInvalidArgument, "modes must be in [1, 200]"};
   if (!core::validPoissonRatio(p.entry.modal.material.poissonRatio))
     return Error{ErrorCode::kInvalidArgument, "Poisson ratio must be in (-1, 0.5)"};
-  if (p.resolution.stoneSubdivisions < 1 || p.resolution.stoneSubdivisions > 4)
-    return Error{ErrorCode::kInvalidArgument, "the stones' subdivisions must be 1 to 4"};
+  if (!volume::validStoneSubdivisions(p.resolution.stoneSubdivisions))
+    return Error{ErrorCode::kInvalidArgument, "the stones' subdivisions must be " +
+                                                  std::to_string(volume::kMinStoneSubdivisions) + " to " +
+                                                  std::to_string(volume::kMaxStoneSubdivisions)};
   return Ok{};
 }
 

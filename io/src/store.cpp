@@ -177,8 +177,10 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
     p.resolution.stacks = j.at("resolution").at("stacks").get<int>();
     // Files from before the stones' subdivisions were stored made them from 320 triangles.
     p.resolution.stoneSubdivisions = j.at("resolution").value("stone_subdivisions", 2);
-    if (p.resolution.stoneSubdivisions < 1 || p.resolution.stoneSubdivisions > 4)
-      return Error{ErrorCode::kParse, "the build parameters' stone subdivisions must be 1 to 4"};
+    if (!volume::validStoneSubdivisions(p.resolution.stoneSubdivisions))
+      return Error{ErrorCode::kParse, "the build parameters' stone subdivisions must be " +
+                                          std::to_string(volume::kMinStoneSubdivisions) + " to " +
+                                          std::to_string(volume::kMaxStoneSubdivisions)};
     volume::EntryOptions& e = p.entry;
     e.descriptor.gridSize = j.at("descriptor").at("grid").get<int>();
     const auto sampling = core::parseSampling(j.at("descriptor").at("sampling").get<std::string>());

@@ -459,8 +459,9 @@ Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolutio
     case Family::kBeam:
       return detail::makeBeamShape(static_cast<detail::BeamSection>(spec.index % 5), a, spec.params.z(), b);
     case Family::kStone:
-      return detail::makeStoneShape(a, b, spec.params.z(), std::clamp(resolution.stoneSubdivisions, 1, 4),
-                                    rng);
+      return detail::makeStoneShape(
+          a, b, spec.params.z(),
+          std::clamp(resolution.stoneSubdivisions, kMinStoneSubdivisions, kMaxStoneSubdivisions), rng);
     case Family::kHoled:
       return detail::makeHoledShape(a, b, static_cast<int>(spec.params.z()), 0.35 + 0.35 * uniformDraw(rng),
                                     segments);

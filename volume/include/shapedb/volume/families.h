@@ -137,10 +137,16 @@ struct ShapeResolution {
   /// Triangles of the families made from level sets (limbed, union) per segment.
   int trianglesPerSegment = 20;
   /// Subdivisions of the icosahedron a stone is made from (1: 80 triangles; 2: 320; each level four
-  /// times the last), in [1, 4]. Its waves are smooth, and 80 triangles keep a stone's frequencies within
-  /// 1 % of its meshing three times finer for half the tets of 320 (docs/accuracy.md).
+  /// times the last; validStoneSubdivisions). Its waves are smooth, and 80 triangles keep a stone's
+  /// frequencies within 1 % of its meshing three times finer for half the tets of 320 (docs/accuracy.md).
   int stoneSubdivisions = 2;
 };
+
+/// The range of ShapeResolution::stoneSubdivisions: 80 to 20,480 triangles.
+inline constexpr int kMinStoneSubdivisions = 1, kMaxStoneSubdivisions = 4;
+inline bool validStoneSubdivisions(int subdivisions) {
+  return subdivisions >= kMinStoneSubdivisions && subdivisions <= kMaxStoneSubdivisions;
+}
 
 /// The closed, outward-oriented surface mesh of a spec: one connected solid, which TetGen meshes.
 /// Deterministic. The families made from level sets (limbed, union) take milliseconds to
