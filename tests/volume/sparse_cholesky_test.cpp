@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <dlfcn.h>
 #include <numeric>
 #include <random>
 #include <string>
@@ -196,6 +197,21 @@ TEST(SparseCholesky, TheAutomaticMethodFollowsTheFactorsDensity) {
     ASSERT_TRUE(forced.factorize(bar));
     EXPECT_EQ(forced.supernodal(), method == CholeskyMethod::kSupernodal) << name(method);
   }
+}
+
+// A threaded OpenBLAS, where it is the BLAS loaded, runs on the calling thread alone once a factorization
+// has been set up: its own threads would contend with the build's workers (sparse_cholesky.cpp).
+TEST(SparseCholesky, AThreadedOpenBlasIsKeptToOneThread) {
+  using Query = int (*)();
+  const auto parallel = reinterpret_cast<Query>(::dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+  const auto threads = reinterpret_cast<Query>(::dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  if (!parallel || !threads || parallel() != 1)
+    GTEST_SKIP() << "the BLAS loaded is not an OpenBLAS with threads of its own";
+  std::mt19937_64 rng(9);
+  const Eigen::SparseMatrix<double> cube = gridMatrix(8, rng);
+  SparseCholesky cholesky(CholeskyMethod::kSupernodal);
+  ASSERT_TRUE(cholesky.factorize(cube));
+  EXPECT_EQ(threads(), 1);
 }
 
 // The database build factorizes on every worker thread at once, through whichever BLAS the system has:

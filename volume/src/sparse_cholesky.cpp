@@ -12,6 +12,14 @@
 namespace shapedb::volume::detail {
 namespace {
 
+/// OpenBLAS's build, if OpenBLAS is the BLAS loaded (openblas_get_parallel: 0 sequential, 1 its own
+/// threads, 2 OpenMP's); null for any other BLAS.
+using Query = int (*)();
+Query openBlasParallel() {
+  static const auto query = reinterpret_cast<Query>(::dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+  return query;
+}
+
 /// CHOLMOD's dense blocks go through whichever BLAS and LAPACK the system provides. Most are safe to call
 /// from several threads at once (the reference ones, BLIS, OpenBLAS built for threads); a sequential
 /// OpenBLAS built without locking (Debian's libopenblas0-serial) is not: concurrent factorizations then
@@ -19,11 +27,27 @@ namespace {
 /// threads take turns; elsewhere this lock is never taken.
 std::mutex* blasLock() {
   static std::mutex* const lock = []() -> std::mutex* {
-    using Query = int (*)();
-    const auto parallel = reinterpret_cast<Query>(::dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
-    return parallel && parallel() == 0 ? new std::mutex : nullptr;  // 0: sequential OpenBLAS
+    const Query parallel = openBlasParallel();
+    return parallel && parallel() == 0 ? new std::mutex : nullptr;
   }();
   return lock;
+}
+
+/// An OpenBLAS built with threads of its own (Debian's libopenblas0-pthread, the one scripts/setup.sh
+/// installs) runs a large dense block on as many threads as there are cores. shapedb's callers already run
+/// one factorization per core (a build's workers, a query's candidates), which those threads would only
+/// contend with, and the haptic loop's core would lose its own. OpenBLAS has no setting per calling
+/// thread, so the first SparseCholesky sets it to one thread for the whole process: other code of the
+/// process that calls the same OpenBLAS (NumPy, where it shares the system's BLAS) then runs on one thread
+/// too (docs/architecture.md). An OpenMP OpenBLAS is kept to the calling thread by SerialOpenMp.
+void oneOpenBlasThread() {
+  static const bool done = [] {
+    const auto set = reinterpret_cast<void (*)(int)>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+    const Query parallel = openBlasParallel();
+    if (set && parallel && parallel() == 1) set(1);
+    return true;
+  }();
+  static_cast<void>(done);
 }
 
 /// Debian's CHOLMOD runs parts of a large factorization in OpenMP parallel regions of up to four threads.
@@ -75,6 +99,11 @@ struct CallGuard {
 
 }  // namespace
 
+double supernodalSwitch() {
+  constexpr double kOpenBlas = 135.0, kOtherBlas = 175.0;  // the header says where they were measured
+  return openBlasParallel() ? kOpenBlas : kOtherBlas;
+}
+
 std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix) {
   const Eigen::Index nodes = matrix.rows() / 3;
   std::vector<Eigen::Triplet<double, int>> pattern;
@@ -105,6 +134,7 @@ struct SparseCholesky::Impl {
   mutable cholmod_dense* e = nullptr;
 
   explicit Impl(CholeskyMethod method) {
+    oneOpenBlasThread();
     cholmod_start(&common);
     common.print = 0;  // errors are returned to the caller, not printed
     // LLᵀ by either method, so that a matrix that is not positive definite is refused by both (a
@@ -113,7 +143,7 @@ struct SparseCholesky::Impl {
     switch (method) {
       case CholeskyMethod::kAuto:
         common.supernodal = CHOLMOD_AUTO;
-        common.supernodal_switch = kSupernodalSwitch;
+        common.supernodal_switch = supernodalSwitch();
         break;
       case CholeskyMethod::kSimplicial:
         common.supernodal = CHOLMOD_SIMPLICIAL;

@@ -2,11 +2,12 @@
 // A sparse Cholesky factorization A = L Lᵀ of a symmetric positive definite matrix by CHOLMOD
 // (SuiteSparse): the modal analysis's shift-invert factors K − σM once and solves with it tens of times,
 // and the morph's registration factors one system per round. Two methods, chosen per matrix once its
-// ordering has been analysed: supernodal, where the factor's dense blocks go through BLAS (a half to a
-// third of the time of a column-by-column factorization for the compact, heavy entries: rings, shells,
-// stones), and simplicial, column by column, where the factor is sparse (slender entries, and every small
-// matrix) and the BLAS calls on small blocks would cost more than their arithmetic. Private to the volume
-// module.
+// ordering has been analysed: supernodal, where the factor's dense blocks go through BLAS (with OpenBLAS
+// a quarter to a third of the time of a column-by-column factorization for the compact, heavy entries:
+// rings, shells, stones, unions), and simplicial, column by column, where the factor is sparse (the most
+// slender entries, and small matrices) and the BLAS calls on small blocks would cost more than their
+// arithmetic. The first one made in a process keeps a threaded OpenBLAS to one thread
+// (sparse_cholesky.cpp). Private to the volume module.
 
 #include <memory>
 #include <vector>
@@ -27,12 +28,13 @@ std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix);
 enum class CholeskyMethod { kAuto, kSimplicial, kSupernodal };
 
 /// kAuto's threshold: supernodal where the factorization's flops per entry of the factor (CHOLMOD's fl /
-/// lnz, known after the analysis) reach this. Measured on the default catalog's quadratic entries with
-/// BLIS as the BLAS (bench/results/epyc-2core/factorization_2026-11-27.md): the simplicial method wins
-/// below ~150 (slender entries, the registration's linear systems: 1.5-6× faster), the supernodal above
-/// ~200 (compact ones, up to 2× faster); CHOLMOD's own default, 40, sends nearly all of them to the
-/// supernodal method.
-inline constexpr double kSupernodalSwitch = 175.0;
+/// lnz, known after the analysis) reach it. It depends on the BLAS the supernodal method's dense blocks go
+/// through, measured on the default catalog's entries, for a factorization alone and with the 64 solves
+/// the modal analysis makes (bench/results/epyc-2core/factorization_2026-11-28.md): 135 with OpenBLAS (the
+/// one scripts/setup.sh installs: its cost per call on small blocks is low), 175 with any other (BLIS, the
+/// reference BLAS: the slender entries and the registration's systems, 74-152, are then 1.5-6× faster
+/// column by column). CHOLMOD's own default, 40, sends nearly every matrix to the supernodal method.
+double supernodalSwitch();
 
 class SparseCholesky {
  public:
