@@ -8,19 +8,21 @@ namespace {
 using core::TetMesh;
 using core::Vec3;
 
-/// Calls sink(a, b, block) with each 3 × 3 block of tet t's element stiffness in meshMotionStiffness:
-/// ∫ λ div u div v + μ (∇u + ∇uᵀ) : ∇v over the tet, times 1/V (the V cancels), for its nodes a and b.
+/// The 3 × 3 block of a tet's element stiffness in meshMotionStiffness for its nodes a and b, from their
+/// shape functions' gradients: ∫ λ div u div v + μ (∇u + ∇uᵀ) : ∇v over the tet, times 1/V (the V
+/// cancels).
+core::Mat3 elementBlock(const Vec3& ga, const Vec3& gb) {
+  constexpr double nu = 0.3, lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = 0.5 / (1.0 + nu);
+  return lambda * ga * gb.transpose() + mu * gb * ga.transpose() + mu * ga.dot(gb) * core::Mat3::Identity();
+}
+
+/// Calls sink(a, b, block) with each 3 × 3 block of tet t's element stiffness (elementBlock).
 template <class Sink>
 void forEachElementBlock(const TetMesh& mesh, std::size_t t, Sink&& sink) {
-  constexpr double nu = 0.3, lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = 0.5 / (1.0 + nu);
   const auto [grad, volume] = core::tetGradients(mesh, t);
   for (int a = 0; a < 4; ++a)
-    for (int b = 0; b < 4; ++b) {
-      const Vec3 ga = grad.col(a), gb = grad.col(b);
-      const core::Mat3 block =
-          lambda * ga * gb.transpose() + mu * gb * ga.transpose() + mu * ga.dot(gb) * core::Mat3::Identity();
-      sink(a, b, block);
-    }
+    for (int b = 0; b < 4; ++b)
+      sink(a, b, elementBlock(grad.col(a), grad.col(b)));
 }
 
 }  // namespace
@@ -141,9 +143,9 @@ InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoun
   }
   if (mInnerCount == 0) return;
   // K_ii: K's rows and columns of the inner nodes. Inner nodes are numbered in the mesh's order, so each
-  // column's rows stay ascending.
+  // column's rows stay ascending, and a node's three columns have the same rows, as in K.
   const SparseMatrix& k = mStiffness.matrix();
-  mToInner.assign(static_cast<std::size_t>(k.nonZeros()), -1);
+  std::vector<Eigen::Index> toInner(static_cast<std::size_t>(k.nonZeros()), -1);  // K's value → K_ii's
   mKii.resize(3 * mInnerCount, 3 * mInnerCount);
   std::vector<int> outer(static_cast<std::size_t>(3 * mInnerCount) + 1, 0), inner;
   for (Eigen::Index col = 0; col < k.outerSize(); ++col) {
@@ -153,7 +155,7 @@ InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoun
     for (Eigen::Index at = k.outerIndexPtr()[col]; at < k.outerIndexPtr()[col + 1]; ++at) {
       const int row = k.innerIndexPtr()[at], u = mInner[static_cast<std::size_t>(row / 3)];
       if (u < 0) continue;
-      mToInner[static_cast<std::size_t>(at)] = static_cast<Eigen::Index>(inner.size());
+      toInner[static_cast<std::size_t>(at)] = static_cast<Eigen::Index>(inner.size());
       inner.push_back(3 * u + row % 3);
     }
     outer[innerCol + 1] = static_cast<int>(inner.size());
@@ -162,29 +164,57 @@ InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoun
   std::copy(outer.begin(), outer.end(), mKii.outerIndexPtr());
   std::copy(inner.begin(), inner.end(), mKii.innerIndexPtr());
   std::fill_n(mKii.valuePtr(), mKii.nonZeros(), 0.0);
+  mColumnStride.resize(static_cast<std::size_t>(mInnerCount));
+  for (std::size_t i = 0; i < mColumnStride.size(); ++i)
+    mColumnStride[i] = outer[3 * i + 1] - outer[3 * i];
+  for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
+    const auto& tet = mesh.tets[t];
+    if (std::none_of(tet.begin(), tet.end(), [&](std::uint32_t v) { return mInner[v] >= 0; })) continue;
+    mActiveTets.push_back(static_cast<std::uint32_t>(t));
+    std::array<Eigen::Index, 16>& start = mBlockStart.emplace_back();
+    for (std::size_t a = 0; a < 4; ++a)
+      for (std::size_t b = 0; b < 4; ++b) {
+        const bool both = mInner[tet[a]] >= 0 && mInner[tet[b]] >= 0;
+        start[4 * a + b] =
+            both ? toInner[static_cast<std::size_t>(mStiffness.valueIndex(tet[a], tet[b], 0, 0))] : -1;
+      }
+  }
 }
 
 Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
-  // Assembled on the mesh as it stands before this increment.
-  const SparseMatrix* k = mInnerCount ? &mStiffness.assemble(mesh) : nullptr;
-  for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
-    if (const int slot = mBoundarySlot[v]; slot >= 0) mesh.nodes[v] += boundaryMove.segment<3>(3 * slot);
-  if (!k) return Ok{};
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
+  if (mInnerCount == 0) {
+    for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
+      mesh.nodes[v] += boundaryMove.segment<3>(3 * mBoundarySlot[v]);
+    return Ok{};
+  }
+  // K_ii and −K_ib u_b, assembled on the mesh as it stands before this increment: the blocks of the inner
+  // nodes' rows only.
   double* kii = mKii.valuePtr();
-  const double* values = k->valuePtr();
-  for (Eigen::Index col = 0; col < k->outerSize(); ++col) {
-    const int slot = mBoundarySlot[static_cast<std::size_t>(col / 3)];
-    for (Eigen::Index at = k->outerIndexPtr()[col]; at < k->outerIndexPtr()[col + 1]; ++at) {
-      const Eigen::Index to = mToInner[static_cast<std::size_t>(at)];
-      if (to >= 0) {
-        kii[to] = values[at];
-      } else if (slot >= 0) {  // column of a boundary node: −K_ib u_b, for the inner rows
-        const int row = k->innerIndexPtr()[at], u = mInner[static_cast<std::size_t>(row / 3)];
-        if (u >= 0) rhs[3 * u + row % 3] -= values[at] * boundaryMove[3 * slot + col % 3];
+  std::fill_n(kii, mKii.nonZeros(), 0.0);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
+  for (std::size_t i = 0; i < mActiveTets.size(); ++i) {
+    const std::size_t t = mActiveTets[i];
+    const auto& tet = mesh.tets[t];
+    const auto [grad, volume] = core::tetGradients(mesh, t);
+    for (std::size_t a = 0; a < 4; ++a) {
+      const int row = mInner[tet[a]];
+      if (row < 0) continue;
+      for (std::size_t b = 0; b < 4; ++b) {
+        const core::Mat3 block =
+            elementBlock(grad.col(static_cast<Eigen::Index>(a)), grad.col(static_cast<Eigen::Index>(b)));
+        if (const Eigen::Index start = mBlockStart[i][4 * a + b]; start >= 0) {
+          const Eigen::Index stride = mColumnStride[static_cast<std::size_t>(mInner[tet[b]])];
+          for (Eigen::Index j = 0; j < 3; ++j)
+            for (Eigen::Index r = 0; r < 3; ++r)
+              kii[start + j * stride + r] += block(r, j);
+        } else {
+          rhs.segment<3>(3 * row) -= block * boundaryMove.segment<3>(3 * mBoundarySlot[tet[b]]);
+        }
       }
     }
   }
+  for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
+    if (const int slot = mBoundarySlot[v]; slot >= 0) mesh.nodes[v] += boundaryMove.segment<3>(3 * slot);
   if (!mAnalyzed) {
     mSolver.analyzePattern(mKii);
     mAnalyzed = true;

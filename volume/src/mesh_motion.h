@@ -56,14 +56,17 @@ class MotionStiffness {
 };
 
 /// Carries a boundary displacement into the interior of a mesh whose tets and boundary stay the same from
-/// call to call: K_ii u_i = −K_ib u_b with K assembled on the mesh as it stands. The inner system's
-/// sparsity and its fill-reducing order are worked out on the first call and kept.
+/// call to call: K_ii u_i = −K_ib u_b with K assembled on the mesh as it stands. Only what the system needs
+/// is assembled, straight into K_ii and the right-hand side: the blocks of the rows of inner nodes, from
+/// the tets that have one (a coarse entry's nodes are mostly on its boundary, and a morph extends tens of
+/// increments). The inner system's sparsity and its fill-reducing order are worked out on the first call
+/// and kept.
 class InteriorMotion {
  public:
   /// `isBoundary[v]`: node v's displacement is given.
   InteriorMotion(const core::TetMesh& mesh, std::span<const char> isBoundary);
 
-  /// The mesh-motion stiffness this assembles (for others to assemble on the same tets).
+  /// The mesh-motion stiffness of the same tets, laid out (for others to assemble on them).
   MotionStiffness& stiffness() { return mStiffness; }
 
   /// Moves `mesh`'s boundary nodes by `boundaryMove` (3 per boundary node, ascending node order) and its
@@ -76,7 +79,12 @@ class InteriorMotion {
   std::vector<int> mBoundarySlot;  ///< per node: its index among the boundary nodes, or −1
   int mInnerCount = 0;
   SparseMatrix mKii;
-  std::vector<Eigen::Index> mToInner;  ///< per value of K: its index in mKii's values, or −1 (coupling)
+  /// The tets with an inner node, and per such tet and pair (a, b) of its nodes, both inner: where K_ii's
+  /// block of rows a and columns b starts in mKii's values (its column j is mColumnStride[b's inner index]
+  /// further on); −1 where a or b is on the boundary.
+  std::vector<std::uint32_t> mActiveTets;
+  std::vector<std::array<Eigen::Index, 16>> mBlockStart;
+  std::vector<Eigen::Index> mColumnStride;  ///< per inner node: the length of each of its K_ii columns
   Eigen::SimplicialLDLT<SparseMatrix> mSolver;
   bool mAnalyzed = false;
 };
