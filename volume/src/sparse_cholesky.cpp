@@ -172,15 +172,16 @@ SparseCholesky::~SparseCholesky() = default;
 
 namespace {
 
-/// A view of `matrix` for CHOLMOD, which reads it, and with stype −1 only its lower triangle.
-cholmod_sparse viewOf(const Eigen::SparseMatrix<double>& matrix) {
+/// A view of `matrix` for CHOLMOD, which reads it, and only the triangle `stype` names: −1 the lower, 1 the
+/// upper.
+cholmod_sparse viewOf(const Eigen::SparseMatrix<double>& matrix, int stype) {
   cholmod_sparse a{};
   a.nrow = a.ncol = static_cast<std::size_t>(matrix.rows());
   a.nzmax = static_cast<std::size_t>(matrix.nonZeros());
   a.p = const_cast<int*>(matrix.outerIndexPtr());
   a.i = const_cast<int*>(matrix.innerIndexPtr());
   a.x = const_cast<double*>(matrix.valuePtr());
-  a.stype = -1;
+  a.stype = stype;
   a.itype = CHOLMOD_INT;
   a.xtype = CHOLMOD_REAL;
   a.dtype = CHOLMOD_DOUBLE;
@@ -197,7 +198,7 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   mRows = 0;
   if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return false;
   if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return false;
-  cholmod_sparse a = viewOf(matrix);
+  cholmod_sparse a = viewOf(matrix, -1);
   s.common.nmethods = 1;
   s.common.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
   s.common.postorder = 1;
@@ -217,7 +218,10 @@ bool SparseCholesky::refactorize(const Eigen::SparseMatrix<double>& matrix) {
 bool SparseCholesky::factorizeNumerically(const Eigen::SparseMatrix<double>& matrix) {
   Impl& s = *mImpl;
   if (!s.factor || matrix.rows() != mRows || matrix.cols() != mRows || !matrix.isCompressed()) return false;
-  cholmod_sparse a = viewOf(matrix);
+  // Each method permutes the triangle it reads in one pass where it is the one it is given: the lower for
+  // the simplicial method, the upper for the supernodal one (which makes two passes of the lower; a
+  // tenth of a supernodal factorization of a compact entry went into them).
+  cholmod_sparse a = viewOf(matrix, s.factor->is_super ? 1 : -1);
   if (!cholmod_factorize(&a, s.factor, &s.common) || s.common.status != CHOLMOD_OK ||
       s.factor->minor < s.factor->n) {
     s.freeFactor();

@@ -43,7 +43,8 @@ class SparseCholesky {
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
 
-  /// Factorizes `matrix` (square, symmetric: its lower triangle is read) with its rows and columns taken
+  /// Factorizes `matrix` (square, symmetric, both triangles stored, as FEM matrices are assembled: the
+  /// simplicial method reads the lower, the supernodal one the upper) with its rows and columns taken
   /// in the order `order` (order[k] is the row eliminated k-th: a fill-reducing ordering; CHOLMOD's own
   /// approximate minimum degree when empty). False when it is not positive definite or the factorization
   /// fails (then solve must not be called).
