@@ -219,8 +219,8 @@ bool SparseCholesky::factorizeNumerically(const Eigen::SparseMatrix<double>& mat
   Impl& s = *mImpl;
   if (!s.factor || matrix.rows() != mRows || matrix.cols() != mRows || !matrix.isCompressed()) return false;
   // Each method permutes the triangle it reads in one pass where it is the one it is given: the lower for
-  // the simplicial method, the upper for the supernodal one (which makes two passes of the lower; a
-  // tenth of a supernodal factorization of a compact entry went into them).
+  // the simplicial method, the upper for the supernodal one (given the lower, it makes two passes; the
+  // second took 2-9 % of a supernodal factorization).
   cholmod_sparse a = viewOf(matrix, s.factor->is_super ? 1 : -1);
   if (!cholmod_factorize(&a, s.factor, &s.common) || s.common.status != CHOLMOD_OK ||
       s.factor->minor < s.factor->n) {

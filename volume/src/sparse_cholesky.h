@@ -3,9 +3,9 @@
 // (SuiteSparse): the modal analysis's shift-invert factors K − σM once and solves with it tens of times,
 // and the morph's registration factors one system per round. Two methods, chosen per matrix once its
 // ordering has been analysed: supernodal, where the factor's dense blocks go through BLAS (with OpenBLAS
-// a quarter to a third of the time of a column-by-column factorization for the compact, heavy entries:
-// rings, shells, stones, unions), and simplicial, column by column, where the factor is sparse (the most
-// slender entries, and small matrices) and the BLAS calls on small blocks would cost more than their
+// about a third of the time of a column-by-column factorization for the compact, heavy entries: rings,
+// shells, stones, unions, limbed bodies), and simplicial, column by column, where the factor is sparse (the
+// most slender entries, and small matrices) and the BLAS calls on small blocks would cost more than their
 // arithmetic. The first one made in a process keeps a threaded OpenBLAS to one thread
 // (sparse_cholesky.cpp). Private to the volume module.
 
