@@ -164,18 +164,15 @@ InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoun
   std::copy(outer.begin(), outer.end(), mKii.outerIndexPtr());
   std::copy(inner.begin(), inner.end(), mKii.innerIndexPtr());
   std::fill_n(mKii.valuePtr(), mKii.nonZeros(), 0.0);
-  mColumnStride.resize(static_cast<std::size_t>(mInnerCount));
-  for (std::size_t i = 0; i < mColumnStride.size(); ++i)
-    mColumnStride[i] = outer[3 * i + 1] - outer[3 * i];
   for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
     const auto& tet = mesh.tets[t];
     if (std::none_of(tet.begin(), tet.end(), [&](std::uint32_t v) { return mInner[v] >= 0; })) continue;
-    mActiveTets.push_back(static_cast<std::uint32_t>(t));
-    std::array<Eigen::Index, 16>& start = mBlockStart.emplace_back();
+    ActiveTet& active = mActiveTets.emplace_back();
+    active.tet = static_cast<std::uint32_t>(t);
     for (std::size_t a = 0; a < 4; ++a)
       for (std::size_t b = 0; b < 4; ++b) {
         const bool both = mInner[tet[a]] >= 0 && mInner[tet[b]] >= 0;
-        start[4 * a + b] =
+        active.blockStart[4 * a + b] =
             both ? toInner[static_cast<std::size_t>(mStiffness.valueIndex(tet[a], tet[b], 0, 0))] : -1;
       }
   }
@@ -190,20 +187,21 @@ Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove
   // K_ii and −K_ib u_b, assembled on the mesh as it stands before this increment: the blocks of the inner
   // nodes' rows only.
   double* kii = mKii.valuePtr();
+  const int* kiiColumns = mKii.outerIndexPtr();
   std::fill_n(kii, mKii.nonZeros(), 0.0);
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
-  for (std::size_t i = 0; i < mActiveTets.size(); ++i) {
-    const std::size_t t = mActiveTets[i];
-    const auto& tet = mesh.tets[t];
-    const auto [grad, volume] = core::tetGradients(mesh, t);
+  for (const ActiveTet& active : mActiveTets) {
+    const auto& tet = mesh.tets[active.tet];
+    const auto [grad, volume] = core::tetGradients(mesh, active.tet);
     for (std::size_t a = 0; a < 4; ++a) {
       const int row = mInner[tet[a]];
       if (row < 0) continue;
       for (std::size_t b = 0; b < 4; ++b) {
         const core::Mat3 block =
             elementBlock(grad.col(static_cast<Eigen::Index>(a)), grad.col(static_cast<Eigen::Index>(b)));
-        if (const Eigen::Index start = mBlockStart[i][4 * a + b]; start >= 0) {
-          const Eigen::Index stride = mColumnStride[static_cast<std::size_t>(mInner[tet[b]])];
+        if (const Eigen::Index start = active.blockStart[4 * a + b]; start >= 0) {
+          const int column = 3 * mInner[tet[b]];  // b's three K_ii columns are of one length
+          const Eigen::Index stride = kiiColumns[column + 1] - kiiColumns[column];
           for (Eigen::Index j = 0; j < 3; ++j)
             for (Eigen::Index r = 0; r < 3; ++r)
               kii[start + j * stride + r] += block(r, j);

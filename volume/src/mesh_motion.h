@@ -79,12 +79,14 @@ class InteriorMotion {
   std::vector<int> mBoundarySlot;  ///< per node: its index among the boundary nodes, or −1
   int mInnerCount = 0;
   SparseMatrix mKii;
-  /// The tets with an inner node, and per such tet and pair (a, b) of its nodes, both inner: where K_ii's
-  /// block of rows a and columns b starts in mKii's values (its column j is mColumnStride[b's inner index]
-  /// further on); −1 where a or b is on the boundary.
-  std::vector<std::uint32_t> mActiveTets;
-  std::vector<std::array<Eigen::Index, 16>> mBlockStart;
-  std::vector<Eigen::Index> mColumnStride;  ///< per inner node: the length of each of its K_ii columns
+  /// A tet with an inner node, and per pair (a, b) of its nodes, both inner: where K_ii's block of rows a
+  /// and columns b starts in mKii's values (its column j is j lengths of b's K_ii columns further on); −1
+  /// where a or b is on the boundary.
+  struct ActiveTet {
+    std::uint32_t tet;
+    std::array<Eigen::Index, 16> blockStart;
+  };
+  std::vector<ActiveTet> mActiveTets;
   Eigen::SimplicialLDLT<SparseMatrix> mSolver;
   bool mAnalyzed = false;
 };
