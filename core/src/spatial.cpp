@@ -44,6 +44,56 @@ TrianglePoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b
   return result(a + v * ab + w * ac, 1 - v - w, v, w);
 }
 
+double rayTriangleDistance(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b,
+                           const Vec3& c) {
+  constexpr double kMiss = std::numeric_limits<double>::infinity();
+  const Vec3 e1 = b - a, e2 = c - a, p = direction.cross(e2);
+  const double det = e1.dot(p);
+  if (det == 0.0) return kMiss;
+  const double inverse = 1.0 / det;
+  const Vec3 s = origin - a;
+  const double u = s.dot(p) * inverse;
+  if (!(u >= 0.0 && u <= 1.0)) return kMiss;
+  const Vec3 q = s.cross(e1);
+  const double v = direction.dot(q) * inverse;
+  if (!(v >= 0.0 && u + v <= 1.0)) return kMiss;
+  return e2.dot(q) * inverse;
+}
+
+std::optional<RayHit> firstHitBruteForce(const TriangleMesh& surface, const Vec3& origin,
+                                         const Vec3& direction, double minDistance, std::uint32_t skip) {
+  std::optional<RayHit> best;
+  for (std::uint32_t t = 0; t < surface.triangles.size(); ++t) {
+    if (t == skip) continue;
+    const TriangleMesh::Triangle& tri = surface.triangles[t];
+    const double d = rayTriangleDistance(origin, direction, surface.vertices[tri[0]],
+                                         surface.vertices[tri[1]], surface.vertices[tri[2]]);
+    if (d > minDistance && d < std::numeric_limits<double>::infinity() && (!best || d < best->distance))
+      best = RayHit{t, d};
+  }
+  return best;
+}
+
+std::vector<double> wallThickness(const TriangleMesh& surface) {
+  std::vector<double> thickness(surface.vertices.size(), std::numeric_limits<double>::infinity());
+  if (surface.triangles.empty()) return thickness;
+  const ClosestPointTree tree(surface);
+  for (std::uint32_t t = 0; t < surface.triangles.size(); ++t) {
+    const TriangleMesh::Triangle& tri = surface.triangles[t];
+    const Vec3 &a = surface.vertices[tri[0]], &b = surface.vertices[tri[1]], &c = surface.vertices[tri[2]];
+    const Vec3 normal = (b - a).cross(c - a);
+    const double area2 = normal.norm();
+    if (!(area2 > 0.0)) continue;
+    // Past the triangle's own plane by round-off, not past anything a real wall could be.
+    const double size = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const auto hit = tree.firstHit((a + b + c) / 3.0, -normal / area2, 1e-9 * size, t);
+    if (!hit) continue;
+    for (const std::uint32_t v : tri)
+      thickness[v] = std::min(thickness[v], hit->distance);
+  }
+  return thickness;
+}
+
 namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
@@ -70,6 +120,23 @@ Vec3 toVec3(const std::array<float, 3>& a) {
 
 double boxSquaredDistance(const Vec3& p, const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
   return (toVec3(lo) - p).cwiseMax(p - toVec3(hi)).cwiseMax(0.0).squaredNorm();
+}
+
+/// Where the ray origin + t·direction enters box [lo, hi] within t ∈ [near, far] (the slab method), or
+/// +∞ if it does not. A ray along a box face counts as in the box; round-off may only widen the interval.
+double rayBoxEntry(const Vec3& origin, const Vec3& direction, const std::array<float, 3>& lo,
+                   const std::array<float, 3>& hi, double near, double far) {
+  for (int a = 0; a < 3; ++a) {
+    const double l = lo[static_cast<std::size_t>(a)], h = hi[static_cast<std::size_t>(a)];
+    if (direction[a] == 0.0) {
+      if (origin[a] < l || origin[a] > h) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const double t1 = (l - origin[a]) / direction[a], t2 = (h - origin[a]) / direction[a];
+    near = std::max(near, std::min(t1, t2));
+    far = std::min(far, std::max(t1, t2));
+  }
+  return near <= far * (1.0 + 1e-12) + 1e-300 ? near : std::numeric_limits<double>::infinity();
 }
 
 // How many nodes build() makes for n triangles: each split halves a range, so the count follows from n
@@ -208,6 +275,49 @@ ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double b
     } else {
       stack[top++] = {left, dl};
       stack[top++] = {right, dr};
+    }
+  }
+  return best;
+}
+
+std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3& direction,
+                                                 double minDistance, std::uint32_t skip) const {
+  std::optional<RayHit> best;
+  if (mNodes.empty()) return best;
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double bestDistance = kInfinity;
+  std::array<std::pair<std::uint32_t, double>, 64> stack;
+  int top = 0;
+  stack[top++] = {0, rayBoxEntry(origin, direction, mNodes[0].min, mNodes[0].max, minDistance, kInfinity)};
+  while (top > 0) {
+    const auto [index, entry] = stack[--top];
+    if (entry == kInfinity || entry > bestDistance) continue;  // missed, or behind the best hit
+    const Node& node = mNodes[index];
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        if (mOrder[i] == skip) continue;
+        const auto& t = mTriangles[i];
+        const double d =
+            rayTriangleDistance(origin, direction, mVertices[t[0]], mVertices[t[1]], mVertices[t[2]]);
+        if (d > minDistance && d < bestDistance) {
+          bestDistance = d;
+          best = RayHit{mOrder[i], d};
+        }
+      }
+      continue;
+    }
+    const std::uint32_t left = index + 1, right = node.first;
+    const double el =
+        rayBoxEntry(origin, direction, mNodes[left].min, mNodes[left].max, minDistance, bestDistance);
+    const double er =
+        rayBoxEntry(origin, direction, mNodes[right].min, mNodes[right].max, minDistance, bestDistance);
+    // Nearer child on top of the stack.
+    if (el < er) {
+      stack[top++] = {right, er};
+      stack[top++] = {left, el};
+    } else {
+      stack[top++] = {left, el};
+      stack[top++] = {right, er};
     }
   }
   return best;

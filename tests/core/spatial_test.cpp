@@ -72,6 +72,70 @@ TEST(ClosestPointTree, AgreesWithEveryTriangleWhereFloatBoxesAreCoarse) {
   expectAgreesWithEveryTriangle(huge, rng, 1.5);
 }
 
+// The tree's first hit against every triangle's, for rays from points spread about an ellipsoid turned
+// anywhere, in random directions, from its own triangles' centroids (skipping them) and along the axes
+// (a zero in the direction: the slab test's special case), and at a surface far from the origin.
+TEST(ClosestPointTree, FirstHitAgreesWithEveryTriangle) {
+  std::mt19937_64 rng(9);
+  for (const Vec3& offset : {Vec3(0, 0, 0), Vec3(4e5, -3e5, 2e5)}) {
+    TriangleMesh surface = transformed(makeUvEllipsoid({1.0, 0.6, 0.3}, 24, 12), test::randomSimilarity(rng));
+    for (Vec3& p : surface.vertices)
+      p += offset;
+    SCOPED_TRACE(offset.transpose());
+    const ClosestPointTree tree(surface);
+    const Bounds b = computeBounds(surface);
+    std::uniform_real_distribution<double> u(-0.5, 1.5);
+    std::normal_distribution<double> g;
+    int hits = 0;
+    for (int i = 0; i < 3000; ++i) {
+      Vec3 origin = b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent());
+      Vec3 direction(g(rng), g(rng), g(rng));
+      std::uint32_t skip = std::numeric_limits<std::uint32_t>::max();
+      if (i % 3 == 1) {
+        skip = static_cast<std::uint32_t>(rng() % surface.triangles.size());
+        const auto& t = surface.triangles[skip];
+        origin = (surface.vertices[t[0]] + surface.vertices[t[1]] + surface.vertices[t[2]]) / 3.0;
+      } else if (i % 3 == 2) {
+        direction = Vec3::Zero();
+        direction[static_cast<int>(rng() % 3)] = rng() % 2 ? 1.0 : -1.0;
+      }
+      const double minDistance = i % 5 == 0 ? 0.1 * b.extent().norm() : 0.0;
+      const auto expected = firstHitBruteForce(surface, origin, direction, minDistance, skip);
+      const auto hit = tree.firstHit(origin, direction, minDistance, skip);
+      ASSERT_EQ(hit.has_value(), expected.has_value()) << "ray " << i;
+      if (!hit) continue;
+      ++hits;
+      ASSERT_NE(hit->triangle, skip);
+      ASSERT_NEAR(hit->distance, expected->distance, 1e-12 * (1.0 + expected->distance)) << "ray " << i;
+      const auto& t = surface.triangles[hit->triangle];
+      EXPECT_EQ(rayTriangleDistance(origin, direction, surface.vertices[t[0]], surface.vertices[t[1]],
+                                    surface.vertices[t[2]]),
+                hit->distance);
+    }
+    // Both answers were tried: rays that cross the surface and rays that miss it.
+    EXPECT_GT(hits, 400);
+    EXPECT_LT(hits, 2600);
+  }
+}
+
+// A plate's thickness is its thinnest side at every vertex, corners included; a ball's is its diameter
+// wherever the rays pass near its centre.
+TEST(WallThickness, IsAPlatesThicknessAndABallsDiameter) {
+  std::mt19937_64 rng(10);
+  const Mat4 placed = test::randomSimilarity(rng);
+  const double scale = std::cbrt(placed.topLeftCorner<3, 3>().determinant());
+  TriangleMesh plate = transformed(makeBox({2.0, 1.0, 0.1}), placed);
+  for (const double t : wallThickness(plate))
+    EXPECT_NEAR(t, 0.1 * scale, 1e-9 * scale);
+  const TriangleMesh ball = makeIcosphere(0.5, 3);
+  const std::vector<double> diameters = wallThickness(ball);
+  ASSERT_EQ(diameters.size(), ball.vertices.size());
+  for (const double t : diameters) {
+    EXPECT_GT(t, 0.97);
+    EXPECT_LE(t, 1.0);
+  }
+}
+
 // SurfaceSide against the winding number: points spread over the surface's box, and points just off the
 // surface beside its vertices and edges, where the closest point is a corner or on an edge and only the
 // pseudonormals there tell the side.

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <shapedb/core/physics.h>
@@ -21,7 +22,19 @@ struct TrianglePoint {
 };
 TrianglePoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
-/// Closest-point queries on a triangle surface: an AABB tree (median split, ≤ 4 triangles a leaf),
+/// Where a ray first crosses a triangle surface.
+struct RayHit {
+  std::uint32_t triangle = 0;
+  double distance = 0.0;  ///< along the ray, in lengths of its direction
+};
+
+/// The t at which the line origin + t·direction crosses triangle abc, from either side, edges included
+/// (Möller & Trumbore 1997): negative behind the origin; +∞ if it misses the triangle or runs in its
+/// plane.
+double rayTriangleDistance(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b,
+                           const Vec3& c);
+
+/// Closest-point (and ray) queries on a triangle surface: an AABB tree (median split, ≤ 4 triangles a leaf),
 /// searched nearest box first. Keeps its own copy of the surface, triangles in leaf order and vertices
 /// numbered in the order the leaves first use them, so that a search reads memory nearly in sequence;
 /// the surface need not outlive it. Its boxes are single precision, rounded outward (they still hold
@@ -44,6 +57,11 @@ class ClosestPointTree {
   /// the hint; where several triangles are equally close (at a shared edge or vertex) it may name
   /// another of them.
   Hit closest(const Vec3& p, std::uint32_t hint) const;
+  /// The first triangle other than `skip` that the ray origin + t·direction crosses at a t over
+  /// `minDistance`, nearest box first; none if it crosses none. Where it crosses several at the same t
+  /// (through a shared edge) it may name any of them.
+  std::optional<RayHit> firstHit(const Vec3& origin, const Vec3& direction, double minDistance = 0.0,
+                                 std::uint32_t skip = std::numeric_limits<std::uint32_t>::max()) const;
   bool empty() const { return mOrder.empty(); }
   std::size_t triangleCount() const { return mOrder.size(); }
 
@@ -70,6 +88,18 @@ class ClosestPointTree {
   TrianglePoint closestOnTriangle(const Vec3& p, std::uint32_t position) const;
   std::vector<Node> mNodes;
 };
+
+/// The oracle of ClosestPointTree::firstHit: every triangle tried.
+std::optional<RayHit> firstHitBruteForce(const TriangleMesh& surface, const Vec3& origin,
+                                         const Vec3& direction, double minDistance = 0.0,
+                                         std::uint32_t skip = std::numeric_limits<std::uint32_t>::max());
+
+/// How thick the solid bounded by a closed, outward-wound surface is at each of its vertices: the least,
+/// over the triangles around the vertex, of the distance from the triangle's centroid straight inward
+/// (against its normal) to where that ray leaves the solid. A plate's or a beam's wall gets its
+/// thickness, a ball its diameter. +∞ for a vertex whose triangles have no area or whose rays find no
+/// other side (round-off at an edge). A ClosestPointTree answers the rays.
+std::vector<double> wallThickness(const TriangleMesh& closedSurface);
 
 /// Which side of a closed, consistently oriented surface a point lies on: the sign of (p − q) · n, q the
 /// surface's closest point to p and n the angle-weighted pseudonormal of the face, edge or vertex that q
