@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
@@ -17,6 +18,7 @@
 
 #include <tetgen.h>
 
+#include <shapedb/core/spatial.h>
 #include <shapedb/volume/tetrahedralize.h>
 
 namespace shapedb::volume {
@@ -24,7 +26,29 @@ namespace detail {
 
 using core::TriangleMesh;
 
-TetGenOutput runTetGen(const TriangleMesh& surface, const std::string& switches) {
+namespace {
+
+/// What the tetunsuitable hook reads: TetGen's hook takes no argument of ours, so the run in progress on
+/// this thread leaves it here.
+struct LocalVolumeBound {
+  const core::ClosestPointTree* tree = nullptr;
+  const std::vector<double>* maxVolumes = nullptr;
+};
+thread_local LocalVolumeBound tLocalBound;
+
+/// TetGen's tetunsuitable hook: whether the tet abcd is larger than the bound of the surface triangle
+/// closest to its centroid.
+bool overLocalVolumeBound(REAL* a, REAL* b, REAL* c, REAL* d, REAL* /*elen*/, REAL /*area*/) {
+  const core::Vec3 pa(a[0], a[1], a[2]), pb(b[0], b[1], b[2]), pc(c[0], c[1], c[2]), pd(d[0], d[1], d[2]);
+  const double maxVolume =
+      (*tLocalBound.maxVolumes)[tLocalBound.tree->closest((pa + pb + pc + pd) / 4.0).triangle];
+  return std::abs((pb - pa).cross(pc - pa).dot(pd - pa)) / 6.0 > maxVolume;
+}
+
+}  // namespace
+
+TetGenOutput runTetGen(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
+                       const std::string& switches) {
   tetgenio in, out;
   in.firstnumber = 0;
   in.numberofpoints = static_cast<int>(surface.vertices.size());
@@ -32,6 +56,12 @@ TetGenOutput runTetGen(const TriangleMesh& surface, const std::string& switches)
   for (std::size_t i = 0; i < surface.vertices.size(); ++i)
     for (int k = 0; k < 3; ++k)
       in.pointlist[3 * i + static_cast<std::size_t>(k)] = surface.vertices[i][k];
+  core::ClosestPointTree tree;
+  if (!maxVolumes.empty()) {
+    tree = core::ClosestPointTree(surface);
+    tLocalBound = {&tree, &maxVolumes};
+    in.tetunsuitable = &overLocalVolumeBound;
+  }
   in.numberoffacets = static_cast<int>(surface.triangles.size());
   in.facetlist = new tetgenio::facet[surface.triangles.size()];
   for (std::size_t f = 0; f < surface.triangles.size(); ++f) {
@@ -54,8 +84,10 @@ TetGenOutput runTetGen(const TriangleMesh& surface, const std::string& switches)
     tetrahedralize(writable.data(), &in, &out);
   } catch (int code) {
     result.status = code == 0 ? -1 : code;
-    return result;
   }
+  in.tetunsuitable = nullptr;
+  tLocalBound = {};
+  if (result.status != 0) return result;
   if (out.numberoftetrahedra <= 0 || out.numberofcorners != 4) {
     result.status = -1;
     return result;
@@ -113,25 +145,27 @@ bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline,
   return true;
 }
 
-/// The child's side: requests in (switches, vertices, triangles), TetGenOutputs out, until the parent
-/// closes the socket. Never returns.
+/// The child's side: requests in (switches, vertices, triangles, local volume bounds), TetGenOutputs out,
+/// until the parent closes the socket. Never returns.
 [[noreturn]] void serveTetGen(int fd) {
   const Deadline never = std::chrono::steady_clock::time_point::max();
   for (;;) {
     bool timedOut = false;
-    std::uint64_t header[3];  // switches length, vertex count, triangle count
+    std::uint64_t header[4];  // switches length, vertex count, triangle count, local bound count
     if (!receiveAll(fd, header, sizeof header, never, timedOut)) ::_exit(0);
     std::string switches(header[0], '\0');
     TriangleMesh surface;
     surface.vertices.resize(header[1]);
     surface.triangles.resize(header[2]);
+    std::vector<double> maxVolumes(header[3]);
     if (!receiveAll(fd, switches.data(), switches.size(), never, timedOut) ||
         !receiveAll(fd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3), never,
                     timedOut) ||
         !receiveAll(fd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle),
-                    never, timedOut))
+                    never, timedOut) ||
+        !receiveAll(fd, maxVolumes.data(), maxVolumes.size() * sizeof(double), never, timedOut))
       ::_exit(1);
-    const TetGenOutput raw = runTetGen(surface, switches);
+    const TetGenOutput raw = runTetGen(surface, maxVolumes, switches);
     const std::int64_t reply[3] = {raw.status, static_cast<std::int64_t>(raw.nodes.size()),
                                    static_cast<std::int64_t>(raw.tets.size())};
     if (!sendAll(fd, reply, sizeof reply) ||
@@ -149,20 +183,23 @@ class TetGenWorker {
  public:
   ~TetGenWorker() { stop(); }
 
-  Result<TetGenOutput> run(const TriangleMesh& surface, const std::string& switches, double timeout) {
+  Result<TetGenOutput> run(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
+                           const std::string& switches, double timeout) {
     if (mPid <= 0)
       if (Status st = start(); !st) return st.error();
     if (takeInjectedKill()) ::kill(mPid, SIGKILL);
     const Deadline deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(timeout));
-    const std::uint64_t header[3] = {switches.size(), surface.vertices.size(), surface.triangles.size()};
+    const std::uint64_t header[4] = {switches.size(), surface.vertices.size(), surface.triangles.size(),
+                                     maxVolumes.size()};
     bool timedOut = false;
     std::int64_t reply[3] = {0, 0, 0};
     bool ok =
         sendAll(mFd, header, sizeof header) && sendAll(mFd, switches.data(), switches.size()) &&
         sendAll(mFd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3)) &&
         sendAll(mFd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle)) &&
+        sendAll(mFd, maxVolumes.data(), maxVolumes.size() * sizeof(double)) &&
         receiveAll(mFd, reply, sizeof reply, deadline, timedOut);
     TetGenOutput raw;
     if (ok && reply[1] >= 0 && reply[2] >= 0 && reply[1] < (std::int64_t{1} << 34) &&
@@ -239,10 +276,10 @@ class TetGenWorker {
 
 }  // namespace
 
-Result<TetGenOutput> runTetGenGuarded(const TriangleMesh& surface, const std::string& switches,
-                                      double timeout) {
+Result<TetGenOutput> runTetGenGuarded(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
+                                      const std::string& switches, double timeout) {
   thread_local TetGenWorker worker;
-  return worker.run(surface, switches, timeout);
+  return worker.run(surface, maxVolumes, switches, timeout);
 }
 
 /// TetGen's error codes (terminatetetgen in tetgen.cxx).

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include <shapedb/core/mass_properties.h>
+#include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/tetrahedralize.h>
 
@@ -36,6 +38,28 @@ std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, 
   return switches + (mergeFacets ? "Qz" : "MQz");
 }
 
+std::vector<double> wallVolumeBounds(const TriangleMesh& surface, const TetrahedralizeOptions& options,
+                                     double volume) {
+  if (!(options.wallEdgeFraction > 0.0 && options.maxVolumeFraction > 0.0)) return {};
+  // Edges of regular tets: of volume V, a = ∛(6√2 V); of edge a, V = a³ / (6√2).
+  const double largest = std::cbrt(6.0 * std::sqrt(2.0) * options.maxVolumeFraction * volume);
+  const std::vector<double> thickness = core::wallThickness(surface);
+  std::vector<double> bounds(surface.triangles.size(), std::numeric_limits<double>::infinity());
+  bool thin = false;
+  for (std::size_t t = 0; t < bounds.size(); ++t) {
+    const TriangleMesh::Triangle& tri = surface.triangles[t];
+    // The thinnest at its corners: a plate's rim gets its faces' thickness, not its width.
+    const double edge =
+        options.wallEdgeFraction * std::min({thickness[tri[0]], thickness[tri[1]], thickness[tri[2]]});
+    if (!(edge < largest)) continue;  // thick enough for the volume bound's tets (or +∞)
+    const double bounded = std::max(edge, largest / 3.0);
+    bounds[t] = bounded * bounded * bounded / (6.0 * std::sqrt(2.0));
+    thin = true;
+  }
+  if (!thin) bounds.clear();
+  return bounds;
+}
+
 namespace {
 
 /// Whether `mesh` fills the surface whose mass properties are `mass`: the same volume and centroid to
@@ -53,17 +77,18 @@ Status fillsSurface(const TetMesh& mesh, const core::MassProperties& mass) {
 
 /// One TetGen run with these switches, its output checked and turned positive, and checked to fill the
 /// surface: same volume and centroid to 1e-9 (relative).
-Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const TetrahedralizeOptions& options,
-                                   const core::MassProperties& mass, bool mergeFacets) {
+Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const std::vector<double>& wallBounds,
+                                   const TetrahedralizeOptions& options, const core::MassProperties& mass,
+                                   bool mergeFacets) {
   const double volume = mass.volume;
   const std::string switches = tetgenSwitches(options, volume, mergeFacets);
   detail::TetGenOutput raw;
   if (options.guarded) {
-    auto guarded = detail::runTetGenGuarded(surface, switches, options.timeoutSeconds);
+    auto guarded = detail::runTetGenGuarded(surface, wallBounds, switches, options.timeoutSeconds);
     if (!guarded) return guarded.error();
     raw = std::move(guarded).value();
   } else {
-    raw = detail::runTetGen(surface, switches);
+    raw = detail::runTetGen(surface, wallBounds, switches);
   }
   if (raw.status != 0) return Error{ErrorCode::kParse, detail::describeTetGenError(raw.status)};
 
@@ -104,9 +129,14 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     return Error{ErrorCode::kInvalidArgument, "TetGen radius-edge ratio must be at least 1.1 (or 0: none)"};
   if (!(options.maxVolumeFraction >= 0.0 && options.maxVolumeFraction <= 1.0))
     return Error{ErrorCode::kInvalidArgument, "TetGen volume fraction must be in [0, 1]"};
+  if (!(options.wallEdgeFraction >= 0.0 && std::isfinite(options.wallEdgeFraction)))
+    return Error{ErrorCode::kInvalidArgument, "the wall size fraction must be finite and ≥ 0 (0: none)"};
   if (Status valid = core::validateMesh(surface); !valid) return valid.error();
   auto mass = core::computeMassProperties(surface);
   if (!mass) return mass.error();
+  // Per triangle: the same for every run below, the turned surface's included (its triangles are these,
+  // and its volume bounds the same).
+  const std::vector<double> wallBounds = wallVolumeBounds(surface, options, mass->volume);
 
   // TetGen merges adjacent facets it finds nearly coplanar, which moves a surface whose facets are only
   // nearly so (a simplified level-set mesh: the volume changed by 1e-6), or aborts on it. Such a run is
@@ -116,11 +146,11 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // fresh worker, so that a broken worker never changes the mesh. (Under ASan on a loaded machine a
   // worker hung until its timeout now and then; the unmerged run that followed gave another mesh, and a
   // resumed database differed from a clean one.)
-  auto once = [](const TriangleMesh& input, const core::MassProperties& inputMass,
-                 const TetrahedralizeOptions& o, bool mergeFacets) {
-    Result<TetMesh> result = tetrahedralizeOnce(input, o, inputMass, mergeFacets);
+  auto once = [&wallBounds](const TriangleMesh& input, const core::MassProperties& inputMass,
+                            const TetrahedralizeOptions& o, bool mergeFacets) {
+    Result<TetMesh> result = tetrahedralizeOnce(input, wallBounds, o, inputMass, mergeFacets);
     if (!result && result.error().code == ErrorCode::kIo && o.guarded && o.relaxOnFailure)
-      result = tetrahedralizeOnce(input, o, inputMass, mergeFacets);
+      result = tetrahedralizeOnce(input, wallBounds, o, inputMass, mergeFacets);
     return result;
   };
   auto attemptOn = [&](const TriangleMesh& input, const core::MassProperties& inputMass,

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
@@ -16,6 +17,15 @@ struct TetrahedralizeOptions {
   /// Maximum tet volume ('a') as a fraction of the solid's volume: about 1/maxVolumeFraction tets at
   /// least. 0: no volume bound.
   double maxVolumeFraction = 1.0 / 600.0;
+  /// Tets across thin walls. The volume bound alone puts one tet, or none inside, across a wall thinner
+  /// than its tets (a beam's flange, a plate, a limb), and such a wall bends too stiffly. With a fraction
+  /// f > 0, a tet is also split while its volume is over that of a regular tet of edge f·t, t the solid's
+  /// thickness (core::wallThickness, the least at the corners of the surface triangle closest to the
+  /// tet's centroid): about 1/f tets across the wall. Only where f·t is under the edge of a regular tet of
+  /// the volume bound's volume, and never under a third of that edge: no wall gets more than 27 times the
+  /// tets per volume, and a solid with no wall that thin is meshed exactly as without. Needs a volume
+  /// bound. 0: no such bound.
+  double wallEdgeFraction = 0.0;
   /// Run TetGen in a child process, so that a crash or a hang in it (TetGen 1.5 segfaults on some bad
   /// input and aborts on others) becomes an error instead of taking the caller down. Off only for meshes
   /// the caller made itself and for measuring the cost of the guard.
@@ -28,9 +38,15 @@ struct TetrahedralizeOptions {
   bool relaxOnFailure = true;
 };
 
-/// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like; with "M" when `mergeFacets` is
-/// off (see tetrahedralize).
+/// The switches string TetGen gets: "pq1.5a0.00166Qz" and the like; with "M" when `mergeFacets` is off
+/// (see tetrahedralize).
 std::string tetgenSwitches(const TetrahedralizeOptions& options, double volume, bool mergeFacets = true);
+
+/// The wall bound (see wallEdgeFraction) of a solid of this volume: per triangle of `surface`, the largest
+/// volume of a tet closest to it, +∞ where the wall is thick enough for the volume bound's tets; empty
+/// when the bound is off or no wall is that thin.
+std::vector<double> wallVolumeBounds(const core::TriangleMesh& surface, const TetrahedralizeOptions& options,
+                                     double volume);
 
 /// A quality tetrahedral mesh of the solid bounded by `surface` (TetGen: a constrained Delaunay
 /// tetrahedralization of the surface as a piecewise linear complex, refined to the quality bounds). The
