@@ -4,8 +4,8 @@
 // elements. Prints one row per entry and a table per family (median and worst relative error over the five
 // frequencies), with the mean wall time of an entry's tetrahedralization and modes at the build's meshing.
 //   build/release/bin/element_accuracy [--per-family N] [--elements linear|quadratic]
-//       [--quality Q] [--volume-fraction F] [--segments S] [--stacks T] [--stone-subdivisions K]
-//       [--modes M] [--families LIST] [--csv FILE]
+//       [--quality Q] [--volume-fraction F] [--wall-fraction W] [--reference-wall-fraction R]
+//       [--segments S] [--stacks T] [--stone-subdivisions K] [--modes M] [--families LIST] [--csv FILE]
 // Defaults: 6 entries per family spread over the default catalog's sweep, the default build's elements and
 // TetGen bounds, 20 modes (the time a build pays), the default families.
 
@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   std::vector<volume::Family> families(volume::generatedFamilies().begin(),
                                        volume::generatedFamilies().end());
   std::string csvPath;
+  double referenceWallFraction = -1.0;  // < 0: a third of the entries'
   volume::ShapeResolution resolution = defaults.resolution;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -67,6 +68,10 @@ int main(int argc, char** argv) {
       options.tetgen.maxRadiusEdgeRatio = std::atof(argv[++i]);
     } else if (arg == "--volume-fraction" && value) {
       options.tetgen.maxVolumeFraction = std::atof(argv[++i]);
+    } else if (arg == "--wall-fraction" && value) {
+      options.tetgen.wallEdgeFraction = std::atof(argv[++i]);
+    } else if (arg == "--reference-wall-fraction" && value) {
+      referenceWallFraction = std::atof(argv[++i]);
     } else if (arg == "--segments" && value) {
       resolution.segments = std::atoi(argv[++i]);
     } else if (arg == "--stacks" && value) {
@@ -84,22 +89,27 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: %s [--per-family N] [--elements linear|quadratic] [--quality Q]\n"
-                   "       [--volume-fraction F] [--segments S] [--stacks T] [--stone-subdivisions K]\n"
-                   "       [--modes M] [--families LIST] [--csv FILE]\n",
+                   "       [--volume-fraction F] [--wall-fraction W] [--reference-wall-fraction R]\n"
+                   "       [--segments S] [--stacks T] [--stone-subdivisions K] [--modes M]\n"
+                   "       [--families LIST] [--csv FILE]\n",
                    argv[0]);
       return 2;
     }
   }
   options.modal.modes = modes;
-  // The reference: a third of the tet size (1/27 of the volume bound), quality bound 1.5 at most.
+  // The reference: a third of the tet size (1/27 of the volume bound, a third of the wall bound), quality
+  // bound 1.5 at most.
   volume::EntryOptions reference = options;
   reference.modal.modes = 5;
   reference.tetgen.maxRadiusEdgeRatio = std::min(1.5, options.tetgen.maxRadiusEdgeRatio);
   reference.tetgen.maxVolumeFraction = options.tetgen.maxVolumeFraction / 27.0;
+  reference.tetgen.wallEdgeFraction =
+      referenceWallFraction >= 0.0 ? referenceWallFraction : options.tetgen.wallEdgeFraction / 3.0;
   reference.tetgen.timeoutSeconds = 300.0;
-  std::printf("elements %s, TetGen %s against %s, %d modes\n", volume::toString(options.modal.order),
-              volume::tetgenSwitches(options.tetgen, 1.0).c_str(),
-              volume::tetgenSwitches(reference.tetgen, 1.0).c_str(), modes);
+  std::printf("elements %s, TetGen %s (wall bound %g) against %s (%g), %d modes\n",
+              volume::toString(options.modal.order), volume::tetgenSwitches(options.tetgen, 1.0).c_str(),
+              options.tetgen.wallEdgeFraction, volume::tetgenSwitches(reference.tetgen, 1.0).c_str(),
+              reference.tetgen.wallEdgeFraction, modes);
 
   // Samples spread over each family's sweep as far as the default catalog takes it.
   const volume::FamilyMix mix = volume::defaultFamilyMix();

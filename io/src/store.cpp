@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 
@@ -141,7 +142,8 @@ std::string toJson(const BuildParameters& p) {
         {"min_cell_area", e.descriptor.minCellArea}}},
       {"tetgen",
        {{"max_radius_edge_ratio", e.tetgen.maxRadiusEdgeRatio},
-        {"max_volume_fraction", e.tetgen.maxVolumeFraction}}},
+        {"max_volume_fraction", e.tetgen.maxVolumeFraction},
+        {"wall_edge_fraction", e.tetgen.wallEdgeFraction}}},
       {"modes",
        {{"count", e.modal.modes},
         {"poisson_ratio", e.modal.material.poissonRatio},
@@ -189,6 +191,10 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
     e.descriptor.minCellArea = j.at("descriptor").at("min_cell_area").get<double>();
     e.tetgen.maxRadiusEdgeRatio = j.at("tetgen").at("max_radius_edge_ratio").get<double>();
     e.tetgen.maxVolumeFraction = j.at("tetgen").at("max_volume_fraction").get<double>();
+    // Files from before the wall bound have none.
+    e.tetgen.wallEdgeFraction = j.at("tetgen").value("wall_edge_fraction", 0.0);
+    if (!(e.tetgen.wallEdgeFraction >= 0.0 && std::isfinite(e.tetgen.wallEdgeFraction)))
+      return Error{ErrorCode::kParse, "the build parameters' wall edge fraction must be finite and ≥ 0"};
     e.modal.modes = j.at("modes").at("count").get<int>();
     e.modal.material.poissonRatio = j.at("modes").at("poisson_ratio").get<double>();
     // Files from before quadratic tets have no "elements": theirs are linear.

@@ -454,6 +454,37 @@ TEST(BuildCli, QuadraticTetsEndToEnd) {
   EXPECT_NE(resumed.err.find("another elements"), std::string::npos) << resumed.err;
 }
 
+// The wall bound reaches TetGen: the entry's tets are those of the beam's surface meshed with it, more
+// than without it; it is stored with the parameters, and a resume that would change it is refused.
+TEST(BuildCli, TheWallBoundIsABuildParameter) {
+  test::ScratchDir dir("build-wall");
+  const auto db = dir / "walled.db";
+  test::ProcessResult built =
+      test::runProcess(SHAPEDB_CLI, {"build", db.string(), "--entries", "1", "--families", "beam", "--modes",
+                                     "4", "--wall-edge-fraction", "0.7", "--quiet"});
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  test::ProcessResult info = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
+  ASSERT_EQ(info.exitCode, 0) << info.err;
+  const nlohmann::json summary = nlohmann::json::parse(info.out);
+  EXPECT_EQ(summary["parameters"]["tetgen"]["wall_edge_fraction"], 0.7);
+
+  const core::TriangleMesh surface = *volume::makeFamilyShape(volume::familySpec(volume::Family::kBeam, 0));
+  volume::TetrahedralizeOptions options = volume::entryMeshing(volume::ElementOrder::kQuadratic);
+  const auto without = volume::tetrahedralize(surface, options);
+  options.wallEdgeFraction = 0.7;
+  const auto with = volume::tetrahedralize(surface, options);
+  ASSERT_TRUE(without.ok() && with.ok());
+  EXPECT_EQ(summary["mean_tets"].get<double>(), static_cast<double>(with->tetCount()));
+  EXPECT_GT(with->tetCount(), without->tetCount());
+  test::ProcessResult text = test::runProcess(SHAPEDB_CLI, {"info", db.string()});
+  EXPECT_NE(text.out.find("edges ≤ 0.7 of the wall thickness"), std::string::npos) << text.out;
+
+  test::ProcessResult resumed = test::runProcess(
+      SHAPEDB_CLI, {"build", db.string(), "--resume", "--wall-edge-fraction", "0.3", "--quiet"});
+  EXPECT_EQ(resumed.exitCode, 2);
+  EXPECT_NE(resumed.err.find("wall-edge-fraction"), std::string::npos) << resumed.err;
+}
+
 /// Runs one SQL statement on a database file with SQLite itself, as someone who edited the file would.
 void execSql(const std::filesystem::path& path, const std::string& sql) {
   sqlite3* db = nullptr;

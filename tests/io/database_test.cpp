@@ -737,6 +737,26 @@ TEST(BuildParametersJson, StoneSubdivisionsRoundTripAndOlderFilesHaveTwo) {
   EXPECT_NE(back.error().message.find("stone subdivisions"), std::string::npos) << back.error().message;
 }
 
+TEST(BuildParametersJson, TheWallBoundRoundTripsAndOlderFilesHaveNone) {
+  BuildParameters walled;
+  walled.families = {volume::Family::kBeam};
+  walled.entry.tetgen.wallEdgeFraction = 0.7;
+  Result<BuildParameters> back = parseBuildParameters(toJson(walled));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->entry.tetgen.wallEdgeFraction, 0.7);
+
+  // A file written before the wall bound existed meshed without one.
+  nlohmann::json older = nlohmann::json::parse(toJson(walled));
+  older["tetgen"].erase("wall_edge_fraction");
+  back = parseBuildParameters(older.dump());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->entry.tetgen.wallEdgeFraction, 0.0);
+  older["tetgen"]["wall_edge_fraction"] = -1.0;
+  back = parseBuildParameters(older.dump());
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().message.find("wall edge fraction"), std::string::npos) << back.error().message;
+}
+
 TEST(BuildParametersJson, FamilyWeightsRoundTripAndOlderFilesAreEven) {
   BuildParameters weighted;
   weighted.families = {volume::Family::kBox, volume::Family::kFragment};

@@ -159,6 +159,7 @@ volume::EntryOptions truthOptions(const volume::EntryOptions& entry, const Evalu
   // Smaller tets, not better-shaped ones: a tighter quality bound made TetGen refine the sharp features of
   // CAD parts without end (a 1,488-triangle part took 11 minutes at q1.5).
   truth.tetgen.maxVolumeFraction /= options.truthRefinement;
+  truth.tetgen.wallEdgeFraction /= std::cbrt(options.truthRefinement);  // sizes are lengths
   truth.tetgen.timeoutSeconds = 600.0;
   return truth;
 }

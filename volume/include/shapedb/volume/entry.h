@@ -36,7 +36,7 @@ struct EntryOptions {
 };
 
 /// `options` with the modal analysis on `order` elements and the TetGen bounds that go with them
-/// (entryMeshing).
+/// (entryMeshing); the wall bound, which no order sets, is kept.
 EntryOptions withElements(EntryOptions options, ElementOrder order);
 
 /// Wall time of each stage of computeEntry, seconds.
