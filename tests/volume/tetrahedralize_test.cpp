@@ -221,6 +221,11 @@ TEST(Tetrahedralize, TheWallBoundBendsAThickWalledBeamAsAFinerMeshDoes) {
   const core::TriangleMesh cube = core::makeBox(Vec3(1.0, 1.0, 1.0));
   EXPECT_TRUE(wallVolumeBounds(cube, walled, 1.0).empty());
   EXPECT_EQ(meshOrDie(cube, walled).tets, meshOrDie(cube, coarse).tets);
+  TetrahedralizeOptions negative = walled;
+  negative.wallEdgeFraction = -0.5;
+  const Result<TetMesh> refused = tetrahedralize(cube, negative);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("wall edge fraction"), std::string::npos) << refused.error().message;
 }
 
 TEST(Tetrahedralize, BadInputIsAnErrorNotACrash) {

@@ -130,7 +130,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   if (!(options.maxVolumeFraction >= 0.0 && options.maxVolumeFraction <= 1.0))
     return Error{ErrorCode::kInvalidArgument, "TetGen volume fraction must be in [0, 1]"};
   if (!(options.wallEdgeFraction >= 0.0 && std::isfinite(options.wallEdgeFraction)))
-    return Error{ErrorCode::kInvalidArgument, "the wall size fraction must be finite and ≥ 0 (0: none)"};
+    return Error{ErrorCode::kInvalidArgument, "the wall edge fraction must be finite and ≥ 0 (0: none)"};
   if (Status valid = core::validateMesh(surface); !valid) return valid.error();
   auto mass = core::computeMassProperties(surface);
   if (!mass) return mass.error();
