@@ -280,6 +280,28 @@ ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double b
   return best;
 }
 
+void ClosestPointTree::overlapping(const Vec3& lo, const Vec3& hi, std::vector<std::uint32_t>& out) const {
+  if (mNodes.empty()) return;
+  const auto meets = [&](const Node& node) {
+    for (int a = 0; a < 3; ++a)
+      if (!(node.min[a] <= hi[a] && lo[a] <= node.max[a])) return false;
+    return true;
+  };
+  std::array<std::uint32_t, 64> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = mNodes[stack[--top]];
+    if (!meets(node)) continue;
+    if (node.count > 0) {
+      out.insert(out.end(), mOrder.begin() + node.first, mOrder.begin() + node.first + node.count);
+      continue;
+    }
+    stack[top++] = node.first;  // right child
+    stack[top++] = static_cast<std::uint32_t>(&node - mNodes.data()) + 1;
+  }
+}
+
 std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3& direction,
                                                  double minDistance, std::uint32_t skip) const {
   std::optional<RayHit> best;

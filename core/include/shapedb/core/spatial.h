@@ -62,6 +62,9 @@ class ClosestPointTree {
   /// (through a shared edge) it may name any of them.
   std::optional<RayHit> firstHit(const Vec3& origin, const Vec3& direction, double minDistance = 0.0,
                                  std::uint32_t skip = std::numeric_limits<std::uint32_t>::max()) const;
+  /// Appends to `out` every triangle whose box (the tree's own: single precision, rounded outward) meets
+  /// the box [lo, hi]: every triangle that reaches into it, and maybe a few that only come close.
+  void overlapping(const Vec3& lo, const Vec3& hi, std::vector<std::uint32_t>& out) const;
   bool empty() const { return mOrder.empty(); }
   std::size_t triangleCount() const { return mOrder.size(); }
 
