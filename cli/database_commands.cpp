@@ -365,7 +365,7 @@ int runAdd(const AddOptions& o) {
   }
   auto ids = io::addToDatabase(o.path, meshes);
   if (!ids) {
-    printError(ids.error().message);
+    printError(ids.error().message + flagHint(ids.error()));
     return kExitInputError;
   }
   for (std::size_t i = 0; i < ids->size(); ++i)

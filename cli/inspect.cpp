@@ -1,11 +1,13 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
+#include <shapedb/core/self_intersection.h>
 #include <shapedb/io/mesh_io.h>
 
 #include "commands.h"
@@ -21,8 +23,13 @@ struct InspectOptions {
   MeshInputOptions input;
 };
 
-nlohmann::json topologyJson(const io::LoadedMesh& loaded) {
+nlohmann::json topologyJson(const io::LoadedMesh& loaded,
+                            const std::vector<core::TriangleCrossing>& crossings) {
   const core::TopologyReport& t = loaded.topology;
+  nlohmann::json firstCrossing = nullptr;
+  if (!crossings.empty())
+    firstCrossing = {{"triangles", {crossings.front().first, crossings.front().second}},
+                     {"point", toJson(crossings.front().point)}};
   return {{"vertices", t.vertexCount},
           {"unreferenced_vertices", t.unreferencedVertices},
           {"triangles", t.triangleCount},
@@ -37,15 +44,18 @@ nlohmann::json topologyJson(const io::LoadedMesh& loaded) {
           {"zero_area_faces", loaded.defects.zeroAreaFaces},
           {"faces_dropped", loaded.facesDropped},
           {"polygons_triangulated", loaded.polygonsTriangulated},
-          {"welded_vertices", loaded.verticesWelded}};
+          {"welded_vertices", loaded.verticesWelded},
+          {"crossing_triangle_pairs", crossings.size()},
+          {"first_crossing", firstCrossing}};
 }
 
 nlohmann::json reportJson(const InspectOptions& options, const io::LoadedMesh& loaded,
+                          const std::vector<core::TriangleCrossing>& crossings,
                           const core::MassProperties& mp, const core::Normalization& n) {
   return {{"file", options.meshPath},
           {"format", loaded.format},
           {"scale", loaded.scale},
-          {"topology", topologyJson(loaded)},
+          {"topology", topologyJson(loaded, crossings)},
           {"density", mp.density},
           {"mass", mp.mass},
           {"volume", mp.volume},
@@ -70,7 +80,8 @@ nlohmann::json reportJson(const InspectOptions& options, const io::LoadedMesh& l
           {"flipped", mp.wasFlipped || loaded.flippedInsideOut}};
 }
 
-void printText(const InspectOptions& options, const io::LoadedMesh& loaded, const core::MassProperties& mp,
+void printText(const InspectOptions& options, const io::LoadedMesh& loaded,
+               const std::vector<core::TriangleCrossing>& crossings, const core::MassProperties& mp,
                const core::Normalization& n) {
   const core::TopologyReport& t = loaded.topology;
   std::printf("%s (%s): %zu vertices, %zu triangles\n", options.meshPath.c_str(), loaded.format.c_str(),
@@ -81,6 +92,15 @@ void printText(const InspectOptions& options, const io::LoadedMesh& loaded, cons
               t.components == 1 ? "" : "s", t.eulerCharacteristic());
   std::printf("  boundary edges %zu, non-manifold edges %zu, inconsistent edges %zu, zero-area faces %zu\n",
               t.boundaryEdges, t.nonManifoldEdges, t.inconsistentEdges, loaded.defects.zeroAreaFaces);
+  if (crossings.empty()) {
+    std::printf("  crossing triangle pairs 0\n");
+  } else {
+    const core::TriangleCrossing& c = crossings.front();
+    std::printf(
+        "  CROSSING triangle pairs %zu (triangles %u and %u at %s): the surface passes through itself;\n"
+        "  a tet mesh of it (add, enrich, bench's truth) needs --repair\n",
+        crossings.size(), c.first, c.second, toText(c.point).c_str());
+  }
   if (mp.isApproximate)
     std::printf("APPROXIMATE: vertex point masses (paper §4.1); the surface does not bound a solid\n");
   if (mp.wasFlipped || loaded.flippedInsideOut)
@@ -107,10 +127,11 @@ int runInspect(const InspectOptions& options) {
   const io::LoadedMesh* loaded = &input->loaded;
   const core::MassProperties* mp = &input->massProperties;
   const core::Normalization* n = &input->normalization;
+  const std::vector<core::TriangleCrossing> crossings = core::findSelfIntersections(loaded->mesh);
   if (options.json)
-    std::printf("%s\n", reportJson(options, *loaded, *mp, *n).dump(2).c_str());
+    std::printf("%s\n", reportJson(options, *loaded, crossings, *mp, *n).dump(2).c_str());
   else
-    printText(options, *loaded, *mp, *n);
+    printText(options, *loaded, crossings, *mp, *n);
   return kExitOk;
 }
 
@@ -120,7 +141,8 @@ Command addInspectCommand(CLI::App& parent) {
   auto options = std::make_shared<InspectOptions>();
   CLI::App* app = parent.add_subcommand(
       "inspect",
-      "Load a surface mesh and print its topology, exact mass properties (volume, area, centre of mass,\n"
+      "Load a surface mesh and print its topology (with the pairs of triangles that cross: a surface\n"
+      "that passes through itself), exact mass properties (volume, area, centre of mass,\n"
       "inertia), principal moments and axes, and the normalizing transform T = canonicalFromMesh\n"
       "(volume 1, centre of mass at the origin, principal axes on x, y, z), with flags for axes that\n"
       "the shape leaves undetermined. Formats: OBJ, PLY, OFF, STL.");

@@ -12,6 +12,7 @@ std::string flagHint(const Error& error) {
            "closes small holes and remeshes a non-manifold surface";
   if (error.code == ErrorCode::kInconsistentOrientation)
     return "; --repair remeshes it as one consistently oriented surface";
+  if (error.code == ErrorCode::kSelfIntersecting) return "; --repair remeshes it as the solid it encloses";
   return "";
 }
 

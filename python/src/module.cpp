@@ -62,6 +62,8 @@ const char* codeName(ErrorCode code) {
       return "cancelled";
     case ErrorCode::kTooLarge:
       return "too_large";
+    case ErrorCode::kSelfIntersecting:
+      return "self_intersecting";
   }
   return "unknown";
 }

@@ -383,6 +383,25 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   test::ProcessResult notDb = test::runProcess(SHAPEDB_CLI, {"info", mesh.string()});
   EXPECT_EQ(notDb.exitCode, 1);
   EXPECT_NE(notDb.err.find("not a database"), std::string::npos) << notDb.err;
+  // A surface that passes through itself (two boxes that overlap, written as one mesh): refused with the
+  // triangles that cross and the flag that remeshes it, and nothing added.
+  core::TriangleMesh overlap = core::makeBox({1, 1, 1});
+  const core::TriangleMesh other = core::makeBox({1, 1, 1});
+  for (const core::Vec3& v : other.vertices)
+    overlap.vertices.push_back(v + core::Vec3(0.5, 0.3, 0.2));
+  for (const auto& t : other.triangles)
+    overlap.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+  const auto crossed = dir / "crossed.obj";
+  ASSERT_TRUE(io::saveMesh(overlap, crossed).ok());
+  test::ProcessResult refused = test::runProcess(SHAPEDB_CLI, {"add", db.string(), crossed.string()});
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(refused.err.find("crossed.obj"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("passes through itself"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--repair"), std::string::npos) << refused.err;
+  test::ProcessResult after = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
+  ASSERT_EQ(after.exitCode, 0) << after.err;
+  EXPECT_EQ(nlohmann::json::parse(after.out)["entries"], 5);
+
   test::ProcessResult family =
       test::runProcess(SHAPEDB_CLI, {"build", (dir / "x.db").string(), "--families", "torus"});
   EXPECT_EQ(family.exitCode, 2);

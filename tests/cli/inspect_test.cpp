@@ -72,6 +72,38 @@ TEST(CliInspect, TextReportNamesTheFileAndItsNumbers) {
   EXPECT_NE(run.out.find("closed, consistently oriented"), std::string::npos);
 }
 
+// A surface that passes through itself (two boxes that overlap, written as one mesh, as exports of parts
+// are) still has its mass properties, and its crossing triangles are counted and named; a box has none.
+TEST(CliInspect, CountsTheTrianglesThatCross) {
+  test::ScratchDir dir("cli");
+  core::TriangleMesh overlap = core::makeBox({1, 1, 1});
+  const core::TriangleMesh other = core::makeBox({1, 1, 1});
+  for (const core::Vec3& v : other.vertices)
+    overlap.vertices.push_back(v + core::Vec3(0.5, 0.3, 0.2));
+  for (const auto& t : other.triangles)
+    overlap.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+  ASSERT_TRUE(io::saveMesh(overlap, dir / "crossed.obj").ok());
+  ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), dir / "box.obj").ok());
+
+  const test::ProcessResult json = shapedb({"inspect", (dir / "crossed.obj").string(), "--json"});
+  ASSERT_EQ(json.exitCode, 0) << json.err;
+  const nlohmann::json topology = nlohmann::json::parse(json.out)["topology"];
+  EXPECT_GT(topology["crossing_triangle_pairs"].get<int>(), 0);
+  const auto pair = topology["first_crossing"]["triangles"].get<std::vector<int>>();
+  ASSERT_EQ(pair.size(), 2u);
+  EXPECT_LT(pair[0], 12);  // one triangle of each box
+  EXPECT_GE(pair[1], 12);
+  const test::ProcessResult text = shapedb({"inspect", (dir / "crossed.obj").string()});
+  EXPECT_NE(text.out.find("CROSSING triangle pairs"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("--repair"), std::string::npos) << text.out;
+
+  const test::ProcessResult box = shapedb({"inspect", (dir / "box.obj").string(), "--json"});
+  ASSERT_EQ(box.exitCode, 0) << box.err;
+  const nlohmann::json boxTopology = nlohmann::json::parse(box.out)["topology"];
+  EXPECT_EQ(boxTopology["crossing_triangle_pairs"].get<int>(), 0);
+  EXPECT_TRUE(boxTopology["first_crossing"].is_null());
+}
+
 TEST(CliInspect, OpenMeshFailsWithOneLineUnlessApproximate) {
   test::ScratchDir dir("cli");
   test::writeFile(dir / "open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n");

@@ -235,7 +235,8 @@ TEST(Tetrahedralize, BadInputIsAnErrorNotACrash) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().code, ErrorCode::kNotClosed);
 
-  // Closed and oriented but self-intersecting: two overlapping cubes in one mesh. TetGen's own check.
+  // Closed and oriented but self-intersecting: two overlapping cubes in one mesh. TetGen refuses it, and
+  // the error says why: two of its triangles that cross.
   core::TriangleMesh overlap = core::makeBox(Vec3(1, 1, 1));
   const core::TriangleMesh other = core::transformed(core::makeBox(Vec3(1, 1, 1)), [] {
     core::Mat4 t = core::Mat4::Identity();
@@ -248,7 +249,10 @@ TEST(Tetrahedralize, BadInputIsAnErrorNotACrash) {
     overlap.triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
   r = tetrahedralize(overlap);
   ASSERT_FALSE(r.ok());
-  std::printf("self-intersecting: %s\n", r.error().message.c_str());
+  EXPECT_EQ(r.error().code, ErrorCode::kSelfIntersecting);
+  EXPECT_NE(r.error().message.find("passes through itself"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("pairs of triangles cross; triangles "), std::string::npos)
+      << r.error().message;
 
   // The worker that crashed is replaced: the next mesh tetrahedralizes as before.
   const TetMesh after = meshOrDie(core::makeBox(Vec3(1, 2, 3)));

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include <shapedb/core/mass_properties.h>
+#include <shapedb/core/self_intersection.h>
 #include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/tetrahedralize.h>
@@ -61,6 +62,20 @@ std::vector<double> wallVolumeBounds(const TriangleMesh& surface, const Tetrahed
 }
 
 namespace {
+
+/// Names the first crossing of a surface that TetGen could not mesh, and what TetGen did.
+std::string selfIntersectionMessage(const std::vector<core::TriangleCrossing>& crossings,
+                                    const Error& tetgen) {
+  const core::TriangleCrossing& first = crossings.front();
+  char where[160];
+  std::snprintf(where, sizeof where, "triangles %u and %u cross at (%.6g, %.6g, %.6g)", first.first,
+                first.second, first.point.x(), first.point.y(), first.point.z());
+  const std::string pairs = crossings.size() == 1
+                                ? std::string(where)
+                                : std::to_string(crossings.size()) + " pairs of triangles cross; " + where;
+  return "the surface passes through itself (" + pairs +
+         "), so it bounds no solid to mesh: " + tetgen.message;
+}
 
 /// Whether `mesh` fills the surface whose mass properties are `mass`: the same volume and centroid to
 /// 1e-9 (relative), as tets whose boundary lies on the surface's faces do.
@@ -164,6 +179,13 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   };
   auto attempt = [&](const TetrahedralizeOptions& o) { return attemptOn(surface, *mass, o); };
   Result<TetMesh> tets = attempt(options);
+  if (tets) return tets;
+  // A surface that passes through itself bounds no solid: TetGen refuses it or crashes on it (a scanned
+  // horse did, at every bound), so the runs below would fail as well. Looked for only now, so that a
+  // surface TetGen meshes costs nothing more.
+  if (const std::vector<core::TriangleCrossing> crossings = core::findSelfIntersections(surface);
+      !crossings.empty())
+    return Error{ErrorCode::kSelfIntersecting, selfIntersectionMessage(crossings, tets.error())};
   if (!options.relaxOnFailure) return tets;
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
   // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.

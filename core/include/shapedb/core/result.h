@@ -25,6 +25,7 @@ enum class ErrorCode {
   kInvalidArgument,          ///< a parameter outside its documented range
   kCancelled,                ///< work abandoned before it was done: its owner shut down first
   kTooLarge,                 ///< the input would need more memory than there is
+  kSelfIntersecting,         ///< the surface passes through itself: it bounds no solid to mesh
 };
 
 /// A recoverable failure: a code and a one-line message that names the input and the problem,

@@ -56,8 +56,10 @@ std::vector<double> wallVolumeBounds(const core::TriangleMesh& surface, const Te
 ///
 /// The input is validated first (finite, indices in range, no degenerate face, closed, consistently and
 /// outward oriented, positive volume): TetGen is never handed a mesh it is known to choke on. Errors: the
-/// validation's, kParse if TetGen refuses the input (self-intersections, say), kIo if the guarded child
-/// crashed or timed out (the message says which signal). Thread-safe.
+/// validation's; kSelfIntersecting if TetGen failed and the surface crosses itself (the message names two
+/// triangles that cross, where, and what TetGen did: it refuses such a surface, or crashes on it);
+/// otherwise kParse if TetGen refuses the input, kIo if the guarded child crashed or timed out (the
+/// message says which signal). Thread-safe.
 Result<core::TetMesh> tetrahedralize(const core::TriangleMesh& surface,
                                      const TetrahedralizeOptions& options = {});
 
