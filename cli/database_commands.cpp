@@ -351,6 +351,7 @@ struct AddOptions {
   MeshLoadFlags load;
   std::string path;
   std::vector<std::string> meshes;
+  io::AddOptions add;
 };
 
 int runAdd(const AddOptions& o) {
@@ -361,9 +362,15 @@ int runAdd(const AddOptions& o) {
       printError(loaded.error().message);
       return kExitInputError;
     }
+    const std::size_t triangles = loaded->mesh.triangleCount();
+    if (o.add.maxTriangles > 0 && triangles > o.add.maxTriangles)
+      std::fprintf(stderr,
+                   "shapedb: note: %s: its %zu triangles are simplified to at most %zu for the tets (within "
+                   "1e-3 of its size; --max-triangles 0 keeps them all)\n",
+                   file.c_str(), triangles, o.add.maxTriangles);
     meshes.push_back({std::filesystem::path(file).filename().string(), file, std::move(loaded->mesh)});
   }
-  auto ids = io::addToDatabase(o.path, meshes);
+  auto ids = io::addToDatabase(o.path, meshes, o.add);
   if (!ids) {
     printError(ids.error().message + flagHint(ids.error()));
     return kExitInputError;
@@ -515,6 +522,11 @@ Command addAddCommand(CLI::App& parent) {
       "§7), computed with the database's own parameters; all are added or none.");
   app->add_option("DB", o->path, "Database file")->required();
   app->add_option("MESH", o->meshes, "Closed surface mesh files (.obj, .ply, .off, .stl)")->required();
+  app->add_option("--max-triangles", o->add.maxTriangles,
+                  "A surface of more triangles is simplified to this many before it is meshed (no vertex\n"
+                  "moves further than 1e-3 of its size; TetGen keeps every surface triangle, so a fine scan\n"
+                  "only multiplies the tets and the seconds of their modes). 0: as given")
+      ->capture_default_str();
   addMeshLoadFlags(*app, o->load);
   return {app, [o] { return runAdd(*o); }};
 }

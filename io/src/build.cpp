@@ -14,6 +14,7 @@
 #include <shapedb/core/normalize.h>
 #include <shapedb/io/build.h>
 #include <shapedb/volume/describe.h>
+#include <shapedb/volume/simplify.h>
 
 #include "build_session.h"
 #include "codec.h"
@@ -531,7 +532,8 @@ Result<MergeReport> mergeDatabases(const std::filesystem::path& out,
 }
 
 Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& path,
-                                                 std::span<const NamedMesh> meshes) {
+                                                 std::span<const NamedMesh> meshes,
+                                                 const AddOptions& options) {
   auto store = Store::open(path, /*writable=*/true);
   if (!store) return store.error();
   BuildParameters p = store->parameters();
@@ -544,8 +546,11 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
     next = std::max(next, r.id + 1);
 
   std::vector<Result<volume::EntryData>> results(meshes.size(), Error{ErrorCode::kInvalidArgument, ""});
-  tbb::parallel_for(std::size_t{0}, meshes.size(),
-                    [&](std::size_t i) { results[i] = volume::computeEntry(meshes[i].mesh, p.entry); });
+  tbb::parallel_for(std::size_t{0}, meshes.size(), [&](std::size_t i) {
+    auto surface = volume::surfaceForEntry(meshes[i].mesh, options.maxTriangles);
+    results[i] =
+        surface ? volume::computeEntry(*surface, p.entry) : Result<volume::EntryData>(surface.error());
+  });
   std::vector<EntryRecord> records;
   std::vector<volume::EntryData> data;
   std::vector<core::EntryId> ids;

@@ -102,19 +102,8 @@ void Enricher::Impl::work() {
 void Enricher::Impl::run(Job& job) {
   const std::string where = job.mesh.source.empty() ? job.mesh.name : job.mesh.source;
   const auto compute = [&]() -> Result<Learned> {
-    const core::TriangleMesh* surface = &job.mesh.mesh;
-    core::TriangleMesh simplified;
-    if (options.maxTriangles > 0 && surface->triangleCount() > options.maxTriangles) {
-      auto mass = core::computeMassProperties(*surface);
-      if (!mass) return withContext(mass.error(), where);
-      volume::SimplifyOptions simplify;
-      simplify.maxTriangles = options.maxTriangles;
-      simplify.maxError = 1e-3 * std::cbrt(mass->volume);
-      auto s = volume::simplify(*surface, simplify);
-      if (!s) return withContext(s.error(), where + ": simplifying its surface");
-      simplified = std::move(s).value();
-      surface = &simplified;
-    }
+    auto surface = volume::surfaceForEntry(job.mesh.mesh, options.maxTriangles);
+    if (!surface) return withContext(surface.error(), where);
     auto data = volume::computeEntry(*surface, entryOptions);
     if (!data) return withContext(data.error(), where);
     auto id = database.learn(job.name, where, *data);

@@ -409,6 +409,42 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.db"));
 }
 
+// A fine surface is meshed through its simplification unless told otherwise, with a note that says so.
+// (Fewer triangles are not always fewer tets: TetGen's quality bound refines a sphere's simplified,
+// longer triangles further than the round ones. A scan of 10⁵ triangles is where it tells.)
+TEST(BuildCli, AddSimplifiesAFineSurfaceBeforeItsTets) {
+  test::ScratchDir dir("build-add-fine");
+  const auto db = dir / "small.db";
+  test::ProcessResult built = test::buildWithCli(db, 2, "box", 3);
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  const core::TriangleMesh ball = core::makeIcosphere(0.1, 3);  // 1,280 triangles
+  ASSERT_TRUE(io::saveMesh(ball, dir / "ball.obj").ok());
+  ASSERT_TRUE(io::saveMesh(ball, dir / "ball_as_given.obj").ok());
+
+  test::ProcessResult simplified = test::runProcess(
+      SHAPEDB_CLI, {"add", db.string(), (dir / "ball.obj").string(), "--max-triangles", "300"});
+  ASSERT_EQ(simplified.exitCode, 0) << simplified.err;
+  EXPECT_NE(simplified.err.find("its 1280 triangles are simplified to at most 300"), std::string::npos)
+      << simplified.err;
+  test::ProcessResult asGiven = test::runProcess(
+      SHAPEDB_CLI, {"add", db.string(), (dir / "ball_as_given.obj").string(), "--max-triangles", "0"});
+  ASSERT_EQ(asGiven.exitCode, 0) << asGiven.err;
+  EXPECT_EQ(asGiven.err.find("simplified"), std::string::npos) << asGiven.err;
+
+  auto store = io::Store::open(db);
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  auto entries = store->entries();
+  ASSERT_TRUE(entries.ok());
+  std::size_t simplifiedTets = 0, asGivenTets = 0;
+  for (const io::EntryRecord& e : *entries) {
+    if (e.name == "ball.obj") simplifiedTets = e.tets;
+    if (e.name == "ball_as_given.obj") asGivenTets = e.tets;
+  }
+  EXPECT_GT(simplifiedTets, 0u);
+  EXPECT_GT(asGivenTets, 0u);
+  EXPECT_NE(simplifiedTets, asGivenTets);  // the same surface meshed twice would give the same tets
+}
+
 TEST(BuildCli, QuadraticTetsEndToEnd) {
   test::ScratchDir dir("build-quadratic");
   const auto db = dir / "quadratic.db";

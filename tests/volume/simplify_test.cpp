@@ -1,6 +1,7 @@
 // Simplification: fewer triangles, the same closed solid within the stated distance.
 
 #include <algorithm>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
@@ -59,6 +60,28 @@ TEST(Simplify, ASmallMeshIsUnchangedAndBadInputIsAnError) {
   SimplifyOptions none;
   none.maxError = 0.0;
   EXPECT_EQ(simplify(box, none).error().code, ErrorCode::kInvalidArgument);
+}
+
+// What add and enrich mesh: a surface over the limit simplified within 1e-3 of its size ∛V (whatever its
+// scale), one at or under it, or with no limit, as given.
+TEST(SurfaceForEntry, SimplifiesOnlyOverTheLimitWithinAThousandthOfTheSize) {
+  for (const double radius : {1.0, 0.002}) {
+    SCOPED_TRACE(radius);
+    const core::TriangleMesh sphere = core::makeIcosphere(radius, 4);  // 5,120 triangles
+    Result<core::TriangleMesh> r = surfaceForEntry(sphere, 3000);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_LE(r->triangles.size(), 3000u);
+    const double size = std::cbrt(core::computeMassProperties(sphere)->volume);
+    const core::ClosestPointTree original(sphere);
+    for (const core::Vec3& p : r->vertices)
+      EXPECT_LT((original.closest(p).closest.point - p).norm(), 2e-3 * size);
+    for (const std::size_t limit : {std::size_t{0}, std::size_t{5120}}) {
+      Result<core::TriangleMesh> same = surfaceForEntry(sphere, limit);
+      ASSERT_TRUE(same.ok());
+      EXPECT_EQ(same->triangles, sphere.triangles);
+      EXPECT_EQ(same->vertices, sphere.vertices);
+    }
+  }
 }
 
 }  // namespace

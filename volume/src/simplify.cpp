@@ -1,9 +1,12 @@
+#include <cmath>
+
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModAspectRatioT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/simplify.h>
 
@@ -74,6 +77,18 @@ Result<core::TriangleMesh> simplify(const core::TriangleMesh& input, const Simpl
   if (Status st = core::requireClosedOriented(core::analyzeTopology(out)); !st)
     return withContext(st.error(), "simplify (a bug: the collapses broke the surface)");
   return out;
+}
+
+Result<core::TriangleMesh> surfaceForEntry(const core::TriangleMesh& mesh, std::size_t maxTriangles) {
+  if (maxTriangles == 0 || mesh.triangleCount() <= maxTriangles) return mesh;
+  auto mass = core::computeMassProperties(mesh);
+  if (!mass) return mass.error();
+  SimplifyOptions options;
+  options.maxTriangles = maxTriangles;
+  options.maxError = 1e-3 * std::cbrt(mass->volume);
+  auto simplified = simplify(mesh, options);
+  if (!simplified) return withContext(simplified.error(), "simplifying its surface");
+  return simplified;
 }
 
 }  // namespace shapedb::volume

@@ -100,10 +100,17 @@ struct NamedMesh {
   core::TriangleMesh mesh;
 };
 
+struct AddOptions {
+  /// A surface of more triangles is computed on its simplification to this many
+  /// (volume::surfaceForEntry, as enrich's), 0: as given.
+  std::size_t maxTriangles = 4000;
+};
+
 /// Adds meshes to an existing database as `user` entries, computed with the file's parameters and
 /// written in one transaction: all or none. Returns their ids. TetGen runs guarded (these meshes come
 /// from outside). Errors: the first mesh that fails, named; kInvalidArgument for a name already present.
 Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& path,
-                                                 std::span<const NamedMesh> meshes);
+                                                 std::span<const NamedMesh> meshes,
+                                                 const AddOptions& options = {});
 
 }  // namespace shapedb::io

@@ -38,9 +38,8 @@ struct EnricherOptions {
   /// Objects computed at once, each on a thread of its own (the haptic loop's machine has other work:
   /// one by default). An object's computation uses that thread only, as a build's entries do.
   int workers = 1;
-  /// A surface of more triangles is simplified to this many first (volume::simplify, no vertex further
-  /// than 1e-3 of the object's size from the surface): TetGen keeps every input triangle, so a fine scan
-  /// would only multiply the tets (and the seconds of its modes) without changing them. 0: never.
+  /// A surface of more triangles is simplified to this many first (volume::surfaceForEntry: no vertex
+  /// further than 1e-3 of the object's size from the surface). 0: never.
   std::size_t maxTriangles = 4000;
 };
 

@@ -28,4 +28,10 @@ struct SimplifyOptions {
 /// requireClosedOriented (input, or output, which would be a bug). Thread-safe.
 Result<core::TriangleMesh> simplify(const core::TriangleMesh& mesh, const SimplifyOptions& options = {});
 
+/// The surface an object from outside (`add`, `enrich`) is computed on: simplified to maxTriangles, no
+/// vertex further than 1e-3 of the object's size ∛V from its surface, when it has more (0: never).
+/// TetGen keeps every input triangle, so a fine scan would only multiply the tets, and the seconds of
+/// their modes, without changing what they give. Errors: those of the mass properties and of simplify.
+Result<core::TriangleMesh> surfaceForEntry(const core::TriangleMesh& mesh, std::size_t maxTriangles);
+
 }  // namespace shapedb::volume
