@@ -544,6 +544,14 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
   core::EntryId next = static_cast<core::EntryId>(p.entries);
   for (const EntryRecord& r : *stored)
     next = std::max(next, r.id + 1);
+  // A name already taken is refused before anything is computed (minutes, for a large object).
+  std::set<std::string> names;
+  for (const EntryRecord& r : *stored)
+    names.insert(r.name);
+  for (const NamedMesh& m : meshes)
+    if (!names.insert(m.name).second)
+      return Error{ErrorCode::kInvalidArgument, m.source + ": an entry named '" + m.name +
+                                                    "' is already in the database (or given twice)"};
 
   std::vector<Result<volume::EntryData>> results(meshes.size(), Error{ErrorCode::kInvalidArgument, ""});
   tbb::parallel_for(std::size_t{0}, meshes.size(), [&](std::size_t i) {

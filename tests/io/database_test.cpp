@@ -884,6 +884,19 @@ TEST(Database, AddedMeshesAreFoundAndAnOpenOneIsRefusedWithNothingWritten) {
   auto duplicate = addToDatabase(path, std::span(bad).first(1));
   ASSERT_FALSE(duplicate.ok());
   EXPECT_NE(duplicate.error().message.find("already in the database"), std::string::npos);
+  // Names are checked before anything is computed: an open surface under a taken name is refused for
+  // its name, and so are two meshes of one name.
+  const std::vector<NamedMesh> taken = {{"wedge.obj", "elsewhere/wedge.obj", open}};
+  auto refusedByName = addToDatabase(path, taken);
+  ASSERT_FALSE(refusedByName.ok());
+  EXPECT_NE(refusedByName.error().message.find("elsewhere/wedge.obj: an entry named 'wedge.obj' is already"),
+            std::string::npos)
+      << refusedByName.error().message;
+  const std::vector<NamedMesh> twice = {{"a.obj", "a.obj", wedge}, {"a.obj", "b/a.obj", wedge}};
+  auto refusedTwice = addToDatabase(path, twice);
+  ASSERT_FALSE(refusedTwice.ok());
+  EXPECT_NE(refusedTwice.error().message.find("given twice"), std::string::npos);
+  EXPECT_EQ(Database::open(path)->entries().size(), 3u);
 }
 
 }  // namespace
