@@ -370,7 +370,23 @@ int runAdd(const AddOptions& o) {
                    file.c_str(), triangles, o.add.maxTriangles);
     meshes.push_back({std::filesystem::path(file).filename().string(), file, std::move(loaded->mesh)});
   }
-  auto ids = io::addToDatabase(o.path, meshes, o.add);
+  // Each mesh as it is computed (a thin or large one takes minutes): what it came to and how long it took.
+  io::AddOptions add = o.add;
+  std::size_t done = 0;
+  add.computed = [&](std::size_t i, const Result<volume::EntryData>& computed) {
+    ++done;
+    if (!computed) {
+      std::fprintf(stderr, "shapedb: [%zu/%zu] %s: failed, so none will be added\n", done, meshes.size(),
+                   meshes[i].source.c_str());
+      return;
+    }
+    const volume::StageTimes& t = computed->times;
+    std::fprintf(stderr,
+                 "shapedb: [%zu/%zu] %s: %zu tets, %zu modes in %.1f s (TetGen %.1f s, modes %.1f s)\n", done,
+                 meshes.size(), meshes[i].source.c_str(), computed->physics.tetMesh.tetCount(),
+                 computed->physics.modes.modeCount(), t.total(), t.tetrahedralize, t.modes);
+  };
+  auto ids = io::addToDatabase(o.path, meshes, add);
   if (!ids) {
     printError(ids.error().message + flagHint(ids.error()));
     return kExitInputError;
@@ -519,7 +535,8 @@ Command addAddCommand(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
       "add",
       "Add closed surface meshes to a database as 'user' entries (the scenario-specific database of paper\n"
-      "§7), computed with the database's own parameters; all are added or none.");
+      "§7), computed with the database's own parameters; all are added or none. Each mesh's tets, modes\n"
+      "and time are printed on stderr as it is computed: a large or thin-walled object takes minutes.");
   app->add_option("DB", o->path, "Database file")->required();
   app->add_option("MESH", o->meshes, "Closed surface mesh files (.obj, .ply, .off, .stl)")->required();
   app->add_option("--max-triangles", o->add.maxTriangles,

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <ctime>
+#include <mutex>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -554,10 +555,15 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
                                                     "' is already in the database (or given twice)"};
 
   std::vector<Result<volume::EntryData>> results(meshes.size(), Error{ErrorCode::kInvalidArgument, ""});
+  std::mutex reporting;
   tbb::parallel_for(std::size_t{0}, meshes.size(), [&](std::size_t i) {
     auto surface = volume::surfaceForEntry(meshes[i].mesh, options.maxTriangles);
     results[i] =
         surface ? volume::computeEntry(*surface, p.entry) : Result<volume::EntryData>(surface.error());
+    if (options.computed) {
+      std::lock_guard lock(reporting);
+      options.computed(i, results[i]);
+    }
   });
   std::vector<EntryRecord> records;
   std::vector<volume::EntryData> data;

@@ -359,6 +359,8 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   test::ProcessResult added = test::runProcess(SHAPEDB_CLI, {"add", db.string(), mesh.string()});
   ASSERT_EQ(added.exitCode, 0) << added.err;
   EXPECT_NE(added.out.find("added as entry 4"), std::string::npos) << added.out;
+  EXPECT_NE(added.err.find("[1/1] " + mesh.string() + ": "), std::string::npos) << added.err;  // progress
+  EXPECT_NE(added.err.find(" tets, 3 modes in "), std::string::npos) << added.err;
 
   test::ProcessResult info = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
   ASSERT_EQ(info.exitCode, 0) << info.err;
@@ -398,6 +400,9 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   EXPECT_NE(refused.err.find("crossed.obj"), std::string::npos) << refused.err;
   EXPECT_NE(refused.err.find("passes through itself"), std::string::npos) << refused.err;
   EXPECT_NE(refused.err.find("--repair"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("[1/1] " + crossed.string() + ": failed, so none will be added"),
+            std::string::npos)
+      << refused.err;
   test::ProcessResult after = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
   ASSERT_EQ(after.exitCode, 0) << after.err;
   EXPECT_EQ(nlohmann::json::parse(after.out)["entries"], 5);

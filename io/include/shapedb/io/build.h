@@ -104,6 +104,9 @@ struct AddOptions {
   /// A surface of more triangles is computed on its simplification to this many
   /// (volume::surfaceForEntry, as enrich's), 0: as given.
   std::size_t maxTriangles = 4000;
+  /// Called as each mesh's entry is computed or fails (a large one takes minutes), one call at a time,
+  /// from the thread that computed it: the mesh's index and its result.
+  std::function<void(std::size_t mesh, const Result<volume::EntryData>& computed)> computed;
 };
 
 /// Adds meshes to an existing database as `user` entries, computed with the file's parameters and
