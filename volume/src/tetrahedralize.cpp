@@ -173,7 +173,13 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     Result<TetMesh> result = once(input, inputMass, o, /*mergeFacets=*/true);
     if (!result) {
       Result<TetMesh> unmerged = once(input, inputMass, o, /*mergeFacets=*/false);
-      if (unmerged) result = std::move(unmerged);
+      if (unmerged) return unmerged;
+      // Both said why: the merged run often only that merging moved the surface, the unmerged one what is
+      // wrong with the tets themselves (a CAD part whose two lobes meet along an edge: two pieces).
+      if (unmerged.error().message != result.error().message)
+        return Result<TetMesh>(
+            Error{unmerged.error().code,
+                  result.error().message + "; without merging facets: " + unmerged.error().message});
     }
     return result;
   };
