@@ -14,6 +14,9 @@
 #include <shapedb/volume/modal.h>
 #include <shapedb/volume/tetrahedralize.h>
 
+#include "cholmod_memory_limit.h"
+#include "test_support.h"
+
 namespace shapedb::volume {
 namespace {
 
@@ -373,6 +376,27 @@ TEST(Modal, DisconnectedSolidIsAnError) {
   Result<core::ModalData> modes = computeModes(a, ModalOptions{.modes = 4, .material = core::unitMaterial()});
   ASSERT_FALSE(modes.ok());
   EXPECT_NE(modes.error().message.find("rigid"), std::string::npos) << modes.error().message;
+}
+
+// A factorization that runs out of memory says so, with the factor's size, rather than blaming the tets;
+// with the memory back, the same mesh has its modes.
+TEST(Modal, AFactorizationOutOfMemoryIsSaidSo) {
+  std::mt19937_64 rng(21);
+  const TetMesh grid = test::makeTetGrid(12, 12, 12, 0.1, rng);
+  const ModalOptions options{.modes = 4, .material = core::unitMaterial(0.3), .order = ElementOrder::kLinear};
+  {
+    const test::CholmodMemoryLimit limit(std::size_t{4} << 20);
+    const Result<core::ModalData> refused = computeModes(grid, options);
+    ASSERT_FALSE(refused.ok());
+    std::printf("%s\n", refused.error().message.c_str());
+    EXPECT_EQ(refused.error().code, ErrorCode::kTooLarge);
+    EXPECT_NE(
+        refused.error().message.find("(6591 degrees of freedom) could not be factorized: out of memory"),
+        std::string::npos)
+        << refused.error().message;
+    EXPECT_NE(refused.error().message.find("GB at least"), std::string::npos) << refused.error().message;
+  }
+  EXPECT_TRUE(computeModes(grid, options).ok());
 }
 
 }  // namespace

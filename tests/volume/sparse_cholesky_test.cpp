@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 // A private header of the volume module (volume/src): this test reaches it on its include path.
+#include "cholmod_memory_limit.h"
 #include "sparse_cholesky.h"
 
 namespace shapedb::volume::detail {
@@ -179,6 +180,34 @@ TEST(SparseCholesky, AnIndefiniteOrMalformedMatrixIsRefused) {
     const Eigen::SparseMatrix<double> b = gridMatrix(2, rng);
     EXPECT_FALSE(cholesky.factorize(b, {0, 1, 2})) << "an order of the wrong size";
     EXPECT_TRUE(cholesky.factorize(b)) << "the same object factorizes again";
+  }
+}
+
+// Why a factorization failed: out of memory (its factor's size foreseen), not positive definite, or
+// neither; and after a success, nothing.
+TEST(SparseCholesky, AFailureSaysWhetherMemoryOrThePivotsRanOut) {
+  for (const CholeskyMethod method : kMethods) {
+    SCOPED_TRACE(name(method));
+    std::mt19937_64 rng(16);
+    const Eigen::SparseMatrix<double> large = gridMatrix(14, rng);  // 8,100 rows: a factor of megabytes
+    SparseCholesky cholesky(method);
+    {
+      const test::CholmodMemoryLimit limit(std::size_t{4} << 20);  // refuses the numeric factor's blocks
+      EXPECT_FALSE(cholesky.factorize(large));
+    }
+    EXPECT_EQ(cholesky.failure(), SparseCholesky::Failure::kOutOfMemory);
+    EXPECT_GT(8.0 * cholesky.factorNonzeros(), 4.0 * 1048576.0);  // the numeric factor ran out
+    ASSERT_TRUE(cholesky.factorize(large)) << "with the memory back";
+    EXPECT_EQ(cholesky.failure(), SparseCholesky::Failure::kNone);
+
+    Eigen::SparseMatrix<double> indefinite = gridMatrix(3, rng);
+    indefinite.coeffRef(10, 10) = -1e3;
+    EXPECT_FALSE(cholesky.factorize(indefinite));
+    EXPECT_EQ(cholesky.failure(), SparseCholesky::Failure::kNotPositiveDefinite);
+    Eigen::SparseMatrix<double> rectangular(6, 3);
+    rectangular.makeCompressed();
+    EXPECT_FALSE(cholesky.factorize(rectangular));
+    EXPECT_EQ(cholesky.failure(), SparseCholesky::Failure::kOther);
   }
 }
 

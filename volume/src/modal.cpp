@@ -71,6 +71,9 @@ class SymmetricShiftInvert {
              Eigen::MatrixXd::Identity(images.rows(), images.cols());
   }
   bool ok() const { return mOk; }
+  /// Why the factorization failed, and the size of the factor it foresaw.
+  detail::SparseCholesky::Failure failure() const { return mSolver.failure(); }
+  double factorNonzeros() const { return mSolver.factorNonzeros(); }
   Eigen::Index rows() const { return mM.rows(); }
   Eigen::Index cols() const { return mM.cols(); }
 
@@ -112,6 +115,28 @@ class SymmetricShiftInvert {
   mutable Eigen::VectorXd mScratch, mProduct;
   bool mOk = false;
 };
+
+/// Why K − σM of n degrees of freedom could not be factorized, in words.
+Error factorizationError(const SymmetricShiftInvert& op, Eigen::Index n) {
+  const std::string matrix = "the stiffness matrix (" + std::to_string(n) + " degrees of freedom)";
+  switch (op.failure()) {
+    case detail::SparseCholesky::Failure::kOutOfMemory: {
+      std::string size;
+      if (op.factorNonzeros() > 0.0) {
+        char buffer[96];
+        std::snprintf(buffer, sizeof buffer, " (its factor holds %.3g values, %.2g GB at least)",
+                      op.factorNonzeros(), 8e-9 * op.factorNonzeros());
+        size = buffer;
+      }
+      return Error{ErrorCode::kTooLarge, matrix + " could not be factorized: out of memory" + size};
+    }
+    case detail::SparseCholesky::Failure::kNotPositiveDefinite:
+      return Error{ErrorCode::kParse,
+                   matrix + " could not be factorized: it is not positive definite (degenerate tets?)"};
+    default:
+      return Error{ErrorCode::kParse, matrix + " could not be factorized"};
+  }
+}
 
 /// The six rigid motions (translations along and rotations about x, y, z through the centroid of the
 /// nodes), M-orthonormalized by Gram–Schmidt in the M inner product.
@@ -563,8 +588,7 @@ Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMat
   const double scale = fem.stiffness.diagonal().sum() / fem.mass.diagonal().sum();
   const double sigma = -1e-6 * scale;
   SymmetricShiftInvert op(fem.stiffness, fem.mass, rigid, sigma);
-  if (!op.ok())
-    return Error{ErrorCode::kParse, "the stiffness matrix could not be factorized (degenerate tets?)"};
+  if (!op.ok()) return factorizationError(op, n);
   const Eigen::Index nev = options.modes;
   const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
   Spectra::SymEigsSolver<SymmetricShiftInvert> eigs(op, nev, ncv);

@@ -196,6 +196,8 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   Impl& s = *mImpl;
   s.freeFactor();
   mRows = 0;
+  mFailure = Failure::kOther;
+  mFactorNonzeros = 0.0;
   if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return false;
   if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return false;
   cholmod_sparse a = viewOf(matrix, -1);
@@ -205,7 +207,12 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   const CallGuard guard;
   s.factor =
       cholmod_analyze_p(&a, order.empty() ? nullptr : const_cast<int*>(order.data()), nullptr, 0, &s.common);
-  if (!s.factor) return false;
+  if (!s.factor) {
+    if (s.common.status == CHOLMOD_OUT_OF_MEMORY || s.common.status == CHOLMOD_TOO_LARGE)
+      mFailure = Failure::kOutOfMemory;
+    return false;
+  }
+  mFactorNonzeros = s.common.lnz;
   mRows = matrix.rows();
   return factorizeNumerically(matrix);
 }
@@ -217,6 +224,7 @@ bool SparseCholesky::refactorize(const Eigen::SparseMatrix<double>& matrix) {
 
 bool SparseCholesky::factorizeNumerically(const Eigen::SparseMatrix<double>& matrix) {
   Impl& s = *mImpl;
+  mFailure = Failure::kOther;
   if (!s.factor || matrix.rows() != mRows || matrix.cols() != mRows || !matrix.isCompressed()) return false;
   // Each method permutes the triangle it reads in one pass where it is the one it is given: the lower for
   // the simplicial method, the upper for the supernodal one (given the lower, it makes two passes; the
@@ -224,10 +232,15 @@ bool SparseCholesky::factorizeNumerically(const Eigen::SparseMatrix<double>& mat
   cholmod_sparse a = viewOf(matrix, s.factor->is_super ? 1 : -1);
   if (!cholmod_factorize(&a, s.factor, &s.common) || s.common.status != CHOLMOD_OK ||
       s.factor->minor < s.factor->n) {
+    if (s.common.status == CHOLMOD_OUT_OF_MEMORY || s.common.status == CHOLMOD_TOO_LARGE)
+      mFailure = Failure::kOutOfMemory;
+    else if (s.common.status == CHOLMOD_NOT_POSDEF || s.factor->minor < s.factor->n)
+      mFailure = Failure::kNotPositiveDefinite;
     s.freeFactor();
     mRows = 0;
     return false;
   }
+  mFailure = Failure::kNone;
   return true;
 }
 

@@ -69,6 +69,12 @@ class SparseCholesky {
   bool solveFactorTransposed(const double* b, double* x, Eigen::Index columns = 1) const;
 
   Eigen::Index rows() const { return mRows; }
+  /// Why the last factorize or refactorize returned false (kNone after one that succeeded).
+  enum class Failure { kNone, kNotPositiveDefinite, kOutOfMemory, kOther };
+  Failure failure() const { return mFailure; }
+  /// The nonzeros of the factor the last analysis foresaw (CHOLMOD's lnz): 8 bytes each at least, what a
+  /// factorization that ran out of memory needed.
+  double factorNonzeros() const { return mFactorNonzeros; }
   /// Whether the last successful factorize was supernodal (else simplicial).
   bool supernodal() const;
 
@@ -83,6 +89,8 @@ class SparseCholesky {
   struct Impl;
   std::unique_ptr<Impl> mImpl;
   Eigen::Index mRows = 0;
+  Failure mFailure = Failure::kNone;
+  double mFactorNonzeros = 0.0;
 };
 
 }  // namespace shapedb::volume::detail
