@@ -373,9 +373,11 @@ int runAdd(const AddOptions& o) {
   // Each mesh as it is computed (a thin or large one takes minutes): what it came to and how long it took.
   io::AddOptions add = o.add;
   std::size_t done = 0;
+  bool computeFailed = false;
   add.computed = [&](std::size_t i, const Result<volume::EntryData>& computed) {
     ++done;
     if (!computed) {
+      computeFailed = true;
       std::fprintf(stderr, "shapedb: [%zu/%zu] %s: failed, so none will be added\n", done, meshes.size(),
                    meshes[i].source.c_str());
       return;
@@ -388,7 +390,15 @@ int runAdd(const AddOptions& o) {
   };
   auto ids = io::addToDatabase(o.path, meshes, add);
   if (!ids) {
-    printError(ids.error().message + flagHint(ids.error()));
+    std::string hint = flagHint(ids.error());
+    // TetGen refused or crashed on a surface: the level set --repair makes of it is a clean one, which
+    // meshes where this did not (a CAD part whose lobes meet along an edge, say).
+    if (hint.empty() && computeFailed && !o.load.repair &&
+        (ids.error().code == ErrorCode::kParse || ids.error().code == ErrorCode::kIo))
+      hint =
+          "; --repair remeshes the surface as the solid it encloses, which TetGen may mesh where it could "
+          "not mesh this one";
+    printError(ids.error().message + hint);
     return kExitInputError;
   }
   for (std::size_t i = 0; i < ids->size(); ++i)

@@ -403,6 +403,20 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   EXPECT_NE(refused.err.find("[1/1] " + crossed.string() + ": failed, so none will be added"),
             std::string::npos)
       << refused.err;
+  // Two boxes apart, as one mesh: TetGen meshes them, but the tets make two pieces (they would ring at
+  // zero); refused, with the remeshing flag as what may get past it.
+  core::TriangleMesh apart = core::makeBox({1, 1, 1});
+  for (const core::Vec3& v : other.vertices)
+    apart.vertices.push_back(v + core::Vec3(3.0, 0.0, 0.0));
+  for (const auto& t : other.triangles)
+    apart.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+  const auto twoPieces = dir / "apart.obj";
+  ASSERT_TRUE(io::saveMesh(apart, twoPieces).ok());
+  test::ProcessResult pieces = test::runProcess(SHAPEDB_CLI, {"add", db.string(), twoPieces.string()});
+  EXPECT_EQ(pieces.exitCode, 1);
+  EXPECT_NE(pieces.err.find("2 pieces"), std::string::npos) << pieces.err;
+  EXPECT_NE(pieces.err.find("; --repair remeshes the surface as the solid it encloses"), std::string::npos)
+      << pieces.err;
   test::ProcessResult after = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});
   ASSERT_EQ(after.exitCode, 0) << after.err;
   EXPECT_EQ(nlohmann::json::parse(after.out)["entries"], 5);
