@@ -387,14 +387,8 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   EXPECT_NE(notDb.err.find("not a database"), std::string::npos) << notDb.err;
   // A surface that passes through itself (two boxes that overlap, written as one mesh): refused with the
   // triangles that cross and the flag that remeshes it, and nothing added.
-  core::TriangleMesh overlap = core::makeBox({1, 1, 1});
-  const core::TriangleMesh other = core::makeBox({1, 1, 1});
-  for (const core::Vec3& v : other.vertices)
-    overlap.vertices.push_back(v + core::Vec3(0.5, 0.3, 0.2));
-  for (const auto& t : other.triangles)
-    overlap.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
   const auto crossed = dir / "crossed.obj";
-  ASSERT_TRUE(io::saveMesh(overlap, crossed).ok());
+  ASSERT_TRUE(io::saveMesh(test::twoUnitBoxes({0.5, 0.3, 0.2}), crossed).ok());
   test::ProcessResult refused = test::runProcess(SHAPEDB_CLI, {"add", db.string(), crossed.string()});
   EXPECT_EQ(refused.exitCode, 1);
   EXPECT_NE(refused.err.find("crossed.obj"), std::string::npos) << refused.err;
@@ -405,13 +399,8 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
       << refused.err;
   // Two boxes apart, as one mesh: TetGen meshes them, but the tets make two pieces (they would ring at
   // zero); refused, with the remeshing flag as what may get past it.
-  core::TriangleMesh apart = core::makeBox({1, 1, 1});
-  for (const core::Vec3& v : other.vertices)
-    apart.vertices.push_back(v + core::Vec3(3.0, 0.0, 0.0));
-  for (const auto& t : other.triangles)
-    apart.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
   const auto twoPieces = dir / "apart.obj";
-  ASSERT_TRUE(io::saveMesh(apart, twoPieces).ok());
+  ASSERT_TRUE(io::saveMesh(test::twoUnitBoxes({3.0, 0.0, 0.0}), twoPieces).ok());
   test::ProcessResult pieces = test::runProcess(SHAPEDB_CLI, {"add", db.string(), twoPieces.string()});
   EXPECT_EQ(pieces.exitCode, 1);
   EXPECT_NE(pieces.err.find("2 pieces"), std::string::npos) << pieces.err;

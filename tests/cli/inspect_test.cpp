@@ -76,13 +76,7 @@ TEST(CliInspect, TextReportNamesTheFileAndItsNumbers) {
 // are) still has its mass properties, and its crossing triangles are counted and named; a box has none.
 TEST(CliInspect, CountsTheTrianglesThatCross) {
   test::ScratchDir dir("cli");
-  core::TriangleMesh overlap = core::makeBox({1, 1, 1});
-  const core::TriangleMesh other = core::makeBox({1, 1, 1});
-  for (const core::Vec3& v : other.vertices)
-    overlap.vertices.push_back(v + core::Vec3(0.5, 0.3, 0.2));
-  for (const auto& t : other.triangles)
-    overlap.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
-  ASSERT_TRUE(io::saveMesh(overlap, dir / "crossed.obj").ok());
+  ASSERT_TRUE(io::saveMesh(test::twoUnitBoxes({0.5, 0.3, 0.2}), dir / "crossed.obj").ok());
   ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), dir / "box.obj").ok());
 
   const test::ProcessResult json = shapedb({"inspect", (dir / "crossed.obj").string(), "--json"});

@@ -53,6 +53,11 @@ std::optional<std::filesystem::path> realMeshDirectory(std::string* why = nullpt
 /// interior nodes jittered by up to `jitter`: a conforming tet mesh with irregular tets.
 core::TetMesh makeTetGrid(int nx, int ny, int nz, double jitter, std::mt19937_64& rng);
 
+/// Two unit cubes written as one mesh, the second moved by `offset` (its 8 vertices and 12 triangles
+/// after the first's), as an export of two parts is: overlapping, the surface passes through itself;
+/// apart, it bounds two solids.
+core::TriangleMesh twoUnitBoxes(const core::Vec3& offset);
+
 /// The point a location's barycentric weights give on `mesh`'s nodes.
 core::Vec3 interpolate(const core::TetMesh& mesh, const core::TetLocation& location);
 
