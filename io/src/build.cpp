@@ -543,12 +543,12 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
   if (!stored) return stored.error();
   // User ids follow the catalog's and every id already taken.
   core::EntryId next = static_cast<core::EntryId>(p.entries);
-  for (const EntryRecord& r : *stored)
-    next = std::max(next, r.id + 1);
   // A name already taken is refused before anything is computed (minutes, for a large object).
   std::set<std::string> names;
-  for (const EntryRecord& r : *stored)
+  for (const EntryRecord& r : *stored) {
+    next = std::max(next, r.id + 1);
     names.insert(r.name);
+  }
   for (const NamedMesh& m : meshes)
     if (!names.insert(m.name).second)
       return Error{ErrorCode::kInvalidArgument, m.source + ": an entry named '" + m.name +
@@ -557,9 +557,9 @@ Result<std::vector<core::EntryId>> addToDatabase(const std::filesystem::path& pa
   std::vector<Result<volume::EntryData>> results(meshes.size(), Error{ErrorCode::kInvalidArgument, ""});
   std::mutex reporting;
   tbb::parallel_for(std::size_t{0}, meshes.size(), [&](std::size_t i) {
-    auto surface = volume::surfaceForEntry(meshes[i].mesh, options.maxTriangles);
-    results[i] =
-        surface ? volume::computeEntry(*surface, p.entry) : Result<volume::EntryData>(surface.error());
+    auto simplified = volume::surfaceForEntry(meshes[i].mesh, options.maxTriangles);
+    results[i] = !simplified ? Result<volume::EntryData>(simplified.error())
+                             : volume::computeEntry(*simplified ? **simplified : meshes[i].mesh, p.entry);
     if (options.computed) {
       std::lock_guard lock(reporting);
       options.computed(i, results[i]);

@@ -102,9 +102,10 @@ void Enricher::Impl::work() {
 void Enricher::Impl::run(Job& job) {
   const std::string where = job.mesh.source.empty() ? job.mesh.name : job.mesh.source;
   const auto compute = [&]() -> Result<Learned> {
-    auto surface = volume::surfaceForEntry(job.mesh.mesh, options.maxTriangles);
-    if (!surface) return withContext(surface.error(), where);
-    auto data = volume::computeEntry(*surface, entryOptions);
+    auto simplified = volume::surfaceForEntry(job.mesh.mesh, options.maxTriangles);
+    if (!simplified) return withContext(simplified.error(), where);
+    const core::TriangleMesh& surface = *simplified ? **simplified : job.mesh.mesh;
+    auto data = volume::computeEntry(surface, entryOptions);
     if (!data) return withContext(data.error(), where);
     auto id = database.learn(job.name, where, *data);
     if (!id) return id.error();

@@ -79,8 +79,9 @@ Result<core::TriangleMesh> simplify(const core::TriangleMesh& input, const Simpl
   return out;
 }
 
-Result<core::TriangleMesh> surfaceForEntry(const core::TriangleMesh& mesh, std::size_t maxTriangles) {
-  if (maxTriangles == 0 || mesh.triangleCount() <= maxTriangles) return mesh;
+Result<std::optional<core::TriangleMesh>> surfaceForEntry(const core::TriangleMesh& mesh,
+                                                          std::size_t maxTriangles) {
+  if (maxTriangles == 0 || mesh.triangleCount() <= maxTriangles) return std::optional<core::TriangleMesh>();
   auto mass = core::computeMassProperties(mesh);
   if (!mass) return mass.error();
   SimplifyOptions options;
@@ -88,7 +89,7 @@ Result<core::TriangleMesh> surfaceForEntry(const core::TriangleMesh& mesh, std::
   options.maxError = 1e-3 * std::cbrt(mass->volume);
   auto simplified = simplify(mesh, options);
   if (!simplified) return withContext(simplified.error(), "simplifying its surface");
-  return simplified;
+  return std::optional<core::TriangleMesh>(std::move(simplified).value());
 }
 
 }  // namespace shapedb::volume

@@ -6,6 +6,7 @@
 // bring them down to what physics needs, within a stated distance of the input.
 
 #include <cstddef>
+#include <optional>
 
 #include <shapedb/core/result.h>
 #include <shapedb/core/triangle_mesh.h>
@@ -31,7 +32,9 @@ Result<core::TriangleMesh> simplify(const core::TriangleMesh& mesh, const Simpli
 /// The surface an object from outside (`add`, `enrich`) is computed on: simplified to maxTriangles, no
 /// vertex further than 1e-3 of the object's size ∛V from its surface, when it has more (0: never).
 /// TetGen keeps every input triangle, so a fine scan would only multiply the tets, and the seconds of
-/// their modes, without changing what they give. Errors: those of the mass properties and of simplify.
-Result<core::TriangleMesh> surfaceForEntry(const core::TriangleMesh& mesh, std::size_t maxTriangles);
+/// their modes, without changing what they give. None when `mesh` is to be meshed as given (no copy of it
+/// is made). Errors: those of the mass properties and of simplify.
+Result<std::optional<core::TriangleMesh>> surfaceForEntry(const core::TriangleMesh& mesh,
+                                                          std::size_t maxTriangles);
 
 }  // namespace shapedb::volume
