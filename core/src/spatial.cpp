@@ -114,20 +114,29 @@ float floatAbove(double x) {
   return -floatBelow(-x);
 }
 
-Vec3 toVec3(const std::array<float, 3>& a) {
-  return {a[0], a[1], a[2]};
+// Squared distances from p to the four boxes of a tree node, +∞ to an empty slot's: the four at once.
+template <class Node>
+Eigen::Array4d boxSquaredDistances(const Vec3& p, const Node& node) {
+  Eigen::Array4d sum = Eigen::Array4d::Zero();
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double x = p[static_cast<Eigen::Index>(a)];
+    const Eigen::Array4d lo = Eigen::Map<const Eigen::Array4f>(node.min[a].data()).template cast<double>();
+    const Eigen::Array4d hi = Eigen::Map<const Eigen::Array4f>(node.max[a].data()).template cast<double>();
+    const Eigen::Array4d gap = (lo - x).max(x - hi).max(0.0);
+    sum += gap * gap;
+  }
+  return sum;
 }
 
-double boxSquaredDistance(const Vec3& p, const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
-  return (toVec3(lo) - p).cwiseMax(p - toVec3(hi)).cwiseMax(0.0).squaredNorm();
-}
-
-/// Where the ray origin + t·direction enters box [lo, hi] within t ∈ [near, far] (the slab method), or
-/// +∞ if it does not. A ray along a box face counts as in the box; round-off may only widen the interval.
-double rayBoxEntry(const Vec3& origin, const Vec3& direction, const std::array<float, 3>& lo,
-                   const std::array<float, 3>& hi, double near, double far) {
+/// Where the ray origin + t·direction enters child c's box of a tree node within t ∈ [near, far] (the
+/// slab method), or +∞ if it does not. A ray along a box face counts as in the box; round-off may only
+/// widen the interval.
+template <class Node>
+double rayBoxEntry(const Vec3& origin, const Vec3& direction, const Node& node, std::size_t c, double near,
+                   double far) {
   for (int a = 0; a < 3; ++a) {
-    const double l = lo[static_cast<std::size_t>(a)], h = hi[static_cast<std::size_t>(a)];
+    const auto axis = static_cast<std::size_t>(a);
+    const double l = node.min[axis][c], h = node.max[axis][c];
     if (direction[a] == 0.0) {
       if (origin[a] < l || origin[a] > h) return std::numeric_limits<double>::infinity();
       continue;
@@ -139,12 +148,36 @@ double rayBoxEntry(const Vec3& origin, const Vec3& direction, const std::array<f
   return near <= far * (1.0 + 1e-12) + 1e-300 ? near : std::numeric_limits<double>::infinity();
 }
 
-// How many nodes build() makes for n triangles: each split halves a range, so the count follows from n
-// alone (reserved exactly: a vector that grew would hold both buffers at once).
+// The sizes of a node's children over n triangles: n halved, and each half over a leaf's size halved
+// again (the build's median splits), so that a node has two to four children.
+std::array<std::uint32_t, 4> childSizes(std::uint32_t n, int& count) {
+  std::array<std::uint32_t, 4> sizes{};
+  count = 0;
+  if (n <= kLeafSize) {
+    sizes[count++] = n;
+    return sizes;
+  }
+  for (const std::uint32_t half : {n / 2, n - n / 2}) {
+    if (half <= kLeafSize) {
+      sizes[count++] = half;
+    } else {
+      sizes[count++] = half / 2;
+      sizes[count++] = half - half / 2;
+    }
+  }
+  return sizes;
+}
+
+// How many nodes build() makes for n triangles, which follows from n alone (reserved exactly: a vector
+// that grew would hold both buffers at once).
 std::size_t treeNodeCount(std::uint32_t n, std::map<std::uint32_t, std::size_t>& memo) {
-  if (n <= kLeafSize) return 1;
   if (auto it = memo.find(n); it != memo.end()) return it->second;
-  const std::size_t count = 1 + treeNodeCount(n / 2, memo) + treeNodeCount(n - n / 2, memo);
+  int children = 0;
+  const std::array<std::uint32_t, 4> sizes = childSizes(n, children);
+  std::size_t count = 1;
+  for (int c = 0; c < children; ++c)
+    if (sizes[static_cast<std::size_t>(c)] > kLeafSize)
+      count += treeNodeCount(sizes[static_cast<std::size_t>(c)], memo);
   memo.emplace(n, count);
   return count;
 }
@@ -163,7 +196,8 @@ ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) {
     }
     std::map<std::uint32_t, std::size_t> memo;
     mNodes.reserve(treeNodeCount(n, memo));
-    build(0, n, surface, items);
+    std::array<float, 3> lo{}, hi{};
+    build(0, n, surface, items, lo, hi);
     for (std::uint32_t i = 0; i < n; ++i)
       mOrder[i] = items[i].triangle;
   }
@@ -194,45 +228,77 @@ TrianglePoint ClosestPointTree::closestOnTriangle(const Vec3& p, std::uint32_t p
   return closestPointOnTriangle(p, mVertices[t[0]], mVertices[t[1]], mVertices[t[2]]);
 }
 
-// Splits the triangles mOrder[begin, end) at the median centroid along the centroids' longest extent;
-// boxes are merged bottom-up, so each triangle's corners are read once, at its leaf.
+// A node over items[begin, end): halved at the median centroid along the centroids' longest extent, and
+// each half over a leaf's size halved again; each part a leaf or a node of its own. Boxes are merged
+// bottom-up, so each triangle's corners are read once, at its leaf.
 std::uint32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
-                                      std::vector<Keyed>& items) {
+                                      std::vector<Keyed>& items, std::array<float, 3>& lo,
+                                      std::array<float, 3>& hi) {
   const auto index = static_cast<std::uint32_t>(mNodes.size());
   mNodes.emplace_back();
-  if (end - begin <= kLeafSize) {
-    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::uint32_t i = begin; i < end; ++i)
-      for (std::uint32_t v : surface.triangles[items[i].triangle]) {
-        lo = lo.cwiseMin(surface.vertices[v]);
-        hi = hi.cwiseMax(surface.vertices[v]);
-      }
-    Node& leaf = mNodes[index];
-    for (int a = 0; a < 3; ++a) {
-      leaf.min[a] = floatBelow(lo[a]);
-      leaf.max[a] = floatAbove(hi[a]);
+  {
+    Node& node = mNodes[index];
+    for (auto& axis : node.min)
+      axis.fill(kFloatInfinity);
+    for (auto& axis : node.max)
+      axis.fill(-kFloatInfinity);
+    node.child.fill(Node::kNoChild);
+  }
+  const auto split = [&](std::uint32_t b, std::uint32_t e) {
+    Vec3 cmin = Vec3::Constant(std::numeric_limits<double>::infinity()), cmax = -cmin;
+    for (std::uint32_t i = b; i < e; ++i) {
+      cmin = cmin.cwiseMin(items[i].centroid);
+      cmax = cmax.cwiseMax(items[i].centroid);
     }
-    leaf.first = begin;
-    leaf.count = end - begin;
-    return index;
+    int axis = 0;
+    (cmax - cmin).maxCoeff(&axis);
+    const std::uint32_t mid = b + (e - b) / 2;
+    std::nth_element(items.begin() + b, items.begin() + mid, items.begin() + e,
+                     [axis](const Keyed& x, const Keyed& y) { return x.centroid[axis] < y.centroid[axis]; });
+    return mid;
+  };
+  // The parts, in the order childSizes gives their sizes.
+  std::array<std::uint32_t, 5> bounds{begin};
+  std::size_t parts = 0;
+  if (end - begin <= kLeafSize) {
+    bounds[++parts] = end;
+  } else {
+    const std::uint32_t mid = split(begin, end);
+    for (const auto& [b, e] : {std::pair{begin, mid}, std::pair{mid, end}}) {
+      if (e - b > kLeafSize) bounds[++parts] = split(b, e);
+      bounds[++parts] = e;
+    }
   }
-  Vec3 cmin = Vec3::Constant(std::numeric_limits<double>::infinity()), cmax = -cmin;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    cmin = cmin.cwiseMin(items[i].centroid);
-    cmax = cmax.cwiseMax(items[i].centroid);
-  }
-  int axis = 0;
-  (cmax - cmin).maxCoeff(&axis);
-  const std::uint32_t mid = begin + (end - begin) / 2;
-  std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                   [axis](const Keyed& a, const Keyed& b) { return a.centroid[axis] < b.centroid[axis]; });
-  const std::uint32_t left = build(begin, mid, surface, items);
-  const std::uint32_t right = build(mid, end, surface, items);
-  Node& node = mNodes[index];
-  node.first = right;
-  for (int a = 0; a < 3; ++a) {
-    node.min[a] = std::min(mNodes[left].min[a], mNodes[right].min[a]);
-    node.max[a] = std::max(mNodes[left].max[a], mNodes[right].max[a]);
+  lo.fill(kFloatInfinity);
+  hi.fill(-kFloatInfinity);
+  for (std::size_t c = 0; c < parts; ++c) {
+    const std::uint32_t b = bounds[c], e = bounds[c + 1];
+    std::array<float, 3> clo{}, chi{};
+    std::uint32_t child = b, count = e - b;
+    if (count <= kLeafSize) {
+      Vec3 dlo = Vec3::Constant(std::numeric_limits<double>::infinity()), dhi = -dlo;
+      for (std::uint32_t i = b; i < e; ++i)
+        for (std::uint32_t v : surface.triangles[items[i].triangle]) {
+          dlo = dlo.cwiseMin(surface.vertices[v]);
+          dhi = dhi.cwiseMax(surface.vertices[v]);
+        }
+      for (int a = 0; a < 3; ++a) {
+        clo[static_cast<std::size_t>(a)] = floatBelow(dlo[a]);
+        chi[static_cast<std::size_t>(a)] = floatAbove(dhi[a]);
+      }
+    } else {
+      child = build(b, e, surface, items, clo, chi);
+      count = 0;
+    }
+    Node& node = mNodes[index];
+    node.child[c] = child;
+    node.count[c] = count;
+    for (std::size_t a = 0; a < 3; ++a) {
+      node.min[a][c] = clo[a];
+      node.max[a][c] = chi[a];
+      lo[a] = std::min(lo[a], clo[a]);
+      hi[a] = std::max(hi[a], chi[a]);
+    }
   }
   return index;
 }
@@ -248,15 +314,20 @@ ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p, std::uint32_t hin
 }
 
 ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double bestSq) const {
-  std::array<std::pair<std::uint32_t, double>, 64> stack;
+  // A node (count 0) or a leaf's triangles, and the squared distance to its box.
+  struct Pending {
+    std::uint32_t child, count;
+    double boxSq;
+  };
+  // Each node popped pushes at most four: a tree over 2³² triangles is < 17 nodes deep.
+  std::array<Pending, 72> stack;
   int top = 0;
-  stack[top++] = {0, boxSquaredDistance(p, mNodes[0].min, mNodes[0].max)};
+  stack[top++] = {0, 0, 0.0};
   while (top > 0) {
-    const auto [index, boxSq] = stack[--top];
-    if (boxSq >= bestSq) continue;
-    const Node& node = mNodes[index];
-    if (node.count > 0) {
-      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+    const Pending pending = stack[--top];
+    if (pending.boxSq >= bestSq) continue;
+    if (pending.count > 0) {
+      for (std::uint32_t i = pending.child; i < pending.child + pending.count; ++i) {
         const TrianglePoint q = closestOnTriangle(p, i);
         if (q.squaredDistance < bestSq) {
           bestSq = q.squaredDistance;
@@ -265,40 +336,44 @@ ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double b
       }
       continue;
     }
-    const std::uint32_t left = index + 1, right = node.first;
-    const double dl = boxSquaredDistance(p, mNodes[left].min, mNodes[left].max);
-    const double dr = boxSquaredDistance(p, mNodes[right].min, mNodes[right].max);
-    // Nearer child on top of the stack. A median-split tree over 2³² triangles is < 64 deep.
-    if (dl < dr) {
-      stack[top++] = {right, dr};
-      stack[top++] = {left, dl};
-    } else {
-      stack[top++] = {left, dl};
-      stack[top++] = {right, dr};
+    const Node& node = mNodes[pending.child];
+    const Eigen::Array4d boxSq = boxSquaredDistances(p, node);
+    // The children that may hold a closer point, the nearest pushed last so that it is taken first.
+    std::array<Pending, 4> near;
+    int count = 0;
+    for (std::size_t c = 0; c < 4; ++c) {
+      const double d = boxSq[static_cast<Eigen::Index>(c)];
+      if (!(d < bestSq)) continue;
+      int at = count++;
+      for (; at > 0 && near[static_cast<std::size_t>(at - 1)].boxSq < d; --at)
+        near[static_cast<std::size_t>(at)] = near[static_cast<std::size_t>(at - 1)];
+      near[static_cast<std::size_t>(at)] = {node.child[c], node.count[c], d};
     }
+    for (int c = 0; c < count; ++c)
+      stack[top++] = near[static_cast<std::size_t>(c)];
   }
   return best;
 }
 
 void ClosestPointTree::overlapping(const Vec3& lo, const Vec3& hi, std::vector<std::uint32_t>& out) const {
   if (mNodes.empty()) return;
-  const auto meets = [&](const Node& node) {
-    for (int a = 0; a < 3; ++a)
-      if (!(node.min[a] <= hi[a] && lo[a] <= node.max[a])) return false;
-    return true;
-  };
-  std::array<std::uint32_t, 64> stack;
+  std::array<std::uint32_t, 72> stack;
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = mNodes[stack[--top]];
-    if (!meets(node)) continue;
-    if (node.count > 0) {
-      out.insert(out.end(), mOrder.begin() + node.first, mOrder.begin() + node.first + node.count);
-      continue;
+    for (std::size_t c = 0; c < 4; ++c) {
+      bool meets = node.child[c] != Node::kNoChild;
+      for (std::size_t a = 0; a < 3 && meets; ++a)
+        meets = node.min[a][c] <= hi[static_cast<Eigen::Index>(a)] &&
+                lo[static_cast<Eigen::Index>(a)] <= node.max[a][c];
+      if (!meets) continue;
+      if (node.count[c] > 0) {
+        out.insert(out.end(), mOrder.begin() + node.child[c], mOrder.begin() + node.child[c] + node.count[c]);
+      } else {
+        stack[top++] = node.child[c];
+      }
     }
-    stack[top++] = node.first;  // right child
-    stack[top++] = static_cast<std::uint32_t>(&node - mNodes.data()) + 1;
   }
 }
 
@@ -308,15 +383,18 @@ std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3&
   if (mNodes.empty()) return best;
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   double bestDistance = kInfinity;
-  std::array<std::pair<std::uint32_t, double>, 64> stack;
+  struct Pending {
+    std::uint32_t child, count;
+    double entry;  ///< where the ray enters its box
+  };
+  std::array<Pending, 72> stack;
   int top = 0;
-  stack[top++] = {0, rayBoxEntry(origin, direction, mNodes[0].min, mNodes[0].max, minDistance, kInfinity)};
+  stack[top++] = {0, 0, minDistance};
   while (top > 0) {
-    const auto [index, entry] = stack[--top];
-    if (entry == kInfinity || entry > bestDistance) continue;  // missed, or behind the best hit
-    const Node& node = mNodes[index];
-    if (node.count > 0) {
-      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+    const Pending pending = stack[--top];
+    if (pending.entry > bestDistance) continue;  // behind the best hit
+    if (pending.count > 0) {
+      for (std::uint32_t i = pending.child; i < pending.child + pending.count; ++i) {
         if (mOrder[i] == skip) continue;
         const auto& t = mTriangles[i];
         const double d =
@@ -328,19 +406,21 @@ std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3&
       }
       continue;
     }
-    const std::uint32_t left = index + 1, right = node.first;
-    const double el =
-        rayBoxEntry(origin, direction, mNodes[left].min, mNodes[left].max, minDistance, bestDistance);
-    const double er =
-        rayBoxEntry(origin, direction, mNodes[right].min, mNodes[right].max, minDistance, bestDistance);
-    // Nearer child on top of the stack.
-    if (el < er) {
-      stack[top++] = {right, er};
-      stack[top++] = {left, el};
-    } else {
-      stack[top++] = {left, el};
-      stack[top++] = {right, er};
+    const Node& node = mNodes[pending.child];
+    // The children the ray enters before the best hit, the nearest pushed last.
+    std::array<Pending, 4> entered;
+    int count = 0;
+    for (std::size_t c = 0; c < 4; ++c) {
+      if (node.child[c] == Node::kNoChild) continue;
+      const double entry = rayBoxEntry(origin, direction, node, c, minDistance, bestDistance);
+      if (entry == kInfinity) continue;
+      int at = count++;
+      for (; at > 0 && entered[static_cast<std::size_t>(at - 1)].entry < entry; --at)
+        entered[static_cast<std::size_t>(at)] = entered[static_cast<std::size_t>(at - 1)];
+      entered[static_cast<std::size_t>(at)] = {node.child[c], node.count[c], entry};
     }
+    for (int c = 0; c < count; ++c)
+      stack[top++] = entered[static_cast<std::size_t>(c)];
   }
   return best;
 }

@@ -34,13 +34,15 @@ struct RayHit {
 double rayTriangleDistance(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b,
                            const Vec3& c);
 
-/// Closest-point (and ray) queries on a triangle surface: an AABB tree (median split, ≤ 4 triangles a leaf),
-/// searched nearest box first. Keeps its own copy of the surface, triangles in leaf order and vertices
-/// numbered in the order the leaves first use them, so that a search reads memory nearly in sequence;
-/// the surface need not outlive it. Its boxes are single precision, rounded outward (they still hold
-/// their triangles; distances are computed in double on the vertices): about 60 bytes a triangle in all
-/// on a closed surface, built without a second copy, so that a ten-million-triangle scan's costs about
-/// 0.6 GB. Immutable once built: concurrent queries are safe.
+/// Closest-point (and ray) queries on a triangle surface: an AABB tree of four children a node (median
+/// splits, two levels of them a node; ≤ 4 triangles a leaf), searched nearest box first. A node keeps its
+/// four children's boxes side by side, axis by axis, so that their distances are computed together, and a
+/// search descends half as many levels as a binary tree's. Keeps its own copy of the surface, triangles in
+/// leaf order and vertices numbered in the order the leaves first use them, so that a search reads memory
+/// nearly in sequence; the surface need not outlive it. Its boxes are single precision, rounded outward
+/// (they still hold their triangles; distances are computed in double on the vertices): about 55 bytes a
+/// triangle in all on a closed surface, built without a second copy, so that a ten-million-triangle scan's
+/// costs about 0.55 GB. Immutable once built: concurrent queries are safe.
 class ClosestPointTree {
  public:
   ClosestPointTree() = default;
@@ -69,11 +71,13 @@ class ClosestPointTree {
   std::size_t triangleCount() const { return mOrder.size(); }
 
  private:
-  /// Nodes in depth-first order: an inner node's left child is the node after it.
+  /// A node of up to four children, each a node or a leaf (a run of triangles); nodes in depth-first
+  /// order, the root first. A slot with no child has an empty box (min +∞, max −∞) and kNoChild.
   struct Node {
-    std::array<float, 3> min{}, max{};
-    std::uint32_t first = 0;  ///< leaf: its first triangle in mOrder and mTriangles; inner: the right child
-    std::uint32_t count = 0;  ///< leaf: how many triangles (≥ 1); inner: 0
+    static constexpr std::uint32_t kNoChild = std::numeric_limits<std::uint32_t>::max();
+    std::array<std::array<float, 4>, 3> min{}, max{};  ///< [axis][child]
+    std::array<std::uint32_t, 4> child{};  ///< a node's index; a leaf's first triangle in mOrder, mTriangles
+    std::array<std::uint32_t, 4> count{};  ///< a leaf's triangles (≥ 1); 0 for a node or no child
   };
   /// A triangle as the build splits them: its centroid beside its index, so that a split reads the
   /// centroids in sequence, not through the index.
@@ -81,8 +85,9 @@ class ClosestPointTree {
     Vec3 centroid;
     std::uint32_t triangle;
   };
+  /// Builds the node of triangles items[begin, end) and returns its index; `lo`, `hi` get its box.
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
-                      std::vector<Keyed>& items);
+                      std::vector<Keyed>& items, std::array<float, 3>& lo, std::array<float, 3>& hi);
   Hit search(const Vec3& p, Hit best, double bestSq) const;
   std::vector<std::uint32_t> mOrder;                     ///< triangle indices, leaves contiguous
   std::vector<std::uint32_t> mPosition;                  ///< inverse of mOrder: where triangle t sits
