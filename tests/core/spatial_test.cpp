@@ -120,6 +120,60 @@ TEST(ClosestPointTree, FirstHitAgreesWithEveryTriangle) {
 
 // A plate's thickness is its thinnest side at every vertex, corners included; a ball's is its diameter
 // wherever the rays pass near its centre.
+// Every size of tree from one triangle up: a node holds one to four children, leaves of up to four
+// triangles, so the smallest trees are the build's edge cases. Closest points, first hits and the
+// triangles whose boxes meet a box, each against every triangle, on soups of random triangles.
+TEST(ClosestPointTree, EverySizeAgreesWithEveryTriangle) {
+  std::mt19937_64 rng(10);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto point = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+  for (std::uint32_t n = 1; n <= 40; ++n) {
+    SCOPED_TRACE(n);
+    TriangleMesh soup;
+    for (std::uint32_t t = 0; t < n; ++t) {
+      const Vec3 corner = point();
+      for (int k = 0; k < 3; ++k)
+        soup.vertices.push_back(corner + 0.2 * (point() - Vec3::Constant(0.5)));
+      soup.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+    }
+    const ClosestPointTree tree(soup);
+    ASSERT_EQ(tree.triangleCount(), n);
+    for (int i = 0; i < 50; ++i) {
+      const Vec3 p = 1.4 * point() - Vec3::Constant(0.2);
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& t : soup.triangles)
+        best = std::min(
+            best, closestPointOnTriangle(p, soup.vertices[t[0]], soup.vertices[t[1]], soup.vertices[t[2]])
+                      .squaredDistance);
+      ASSERT_EQ(tree.closest(p).closest.squaredDistance, best);
+
+      const Vec3 direction = point() - Vec3::Constant(0.5);
+      const auto hit = tree.firstHit(p, direction);
+      const auto expected = firstHitBruteForce(soup, p, direction);
+      ASSERT_EQ(hit.has_value(), expected.has_value());
+      if (hit) {
+        ASSERT_EQ(hit->distance, expected->distance);
+      }
+
+      const Vec3 a = point(), b = point(), lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+      std::vector<std::uint32_t> found;
+      tree.overlapping(lo, hi, found);
+      std::sort(found.begin(), found.end());
+      ASSERT_TRUE(std::adjacent_find(found.begin(), found.end()) == found.end()) << "a triangle twice";
+      for (std::uint32_t t = 0; t < n; ++t) {
+        Vec3 tlo = soup.vertices[3 * t], thi = tlo;
+        for (std::uint32_t k = 1; k < 3; ++k) {
+          tlo = tlo.cwiseMin(soup.vertices[3 * t + k]);
+          thi = thi.cwiseMax(soup.vertices[3 * t + k]);
+        }
+        if ((tlo.array() <= hi.array()).all() && (lo.array() <= thi.array()).all()) {
+          ASSERT_TRUE(std::binary_search(found.begin(), found.end(), t)) << "triangle " << t << " missed";
+        }
+      }
+    }
+  }
+}
+
 TEST(WallThickness, IsAPlatesThicknessAndABallsDiameter) {
   std::mt19937_64 rng(10);
   const Mat4 placed = test::randomSimilarity(rng);
