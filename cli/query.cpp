@@ -247,20 +247,31 @@ std::filesystem::path pngPath(const std::string& png, std::size_t index, std::si
 }
 
 /// One line per query: the best match, its fidelity, and the adapted physics in brief.
-void printTableHeader() {
-  std::printf("%-24s %-24s %9s %9s %9s %11s %10s %10s %10s\n", "mesh", "best match", "distance", "dev.mean",
-              "mom.err", "mass (kg)", "f1 (Hz)", "f2 (Hz)", "f3 (Hz)");
+/// The table's first column: as wide as the longest file name it will hold, and never under 24.
+int tableNameWidth(const std::vector<std::string>& files, bool learning) {
+  std::size_t width = 24;
+  for (const std::string& file : files)
+    width = std::max(width, std::filesystem::path(file).filename().string().size() + (learning ? 10 : 0));
+  return static_cast<int>(width);
 }
 
-void printTableRow(const std::string& file, const io::QueryResult& r) {
+void printTableHeader(int nameWidth) {
+  std::printf("%-*s %-24s %9s %9s %9s %9s %11s %10s %10s %10s\n", nameWidth, "mesh", "best match", "distance",
+              "dev.mean", "mom.err", "pred.err", "mass (kg)", "f1 (Hz)", "f2 (Hz)", "f3 (Hz)");
+}
+
+/// One row: the answered match, its fidelity report, the answer's predicted first-frequency error, and
+/// the adapted physics ("-" for what the query did not compute).
+void printTableRow(int nameWidth, const std::string& file, const io::QueryResult& r) {
   const io::MatchReport& m = r.answeredMatch();
-  std::printf("%-24s %-24s %9.4f", std::filesystem::path(file).filename().string().c_str(),
+  std::printf("%-*s %-24s %9.4f", nameWidth, std::filesystem::path(file).filename().string().c_str(),
               m.entry ? m.entry->name.c_str() : "?", m.match.distance);
   if (m.fidelity)
     std::printf(" %9s %9s", percent(m.fidelity->meanDeviation).c_str(),
                 percent(m.fidelity->maxMomentError).c_str());
   else
     std::printf(" %9s %9s", "-", "-");
+  std::printf(" %9s", r.predictedFrequencyError ? percent(*r.predictedFrequencyError).c_str() : "-");
   if (r.physics) {
     const Eigen::VectorXd hz = r.physics->frequenciesHz();
     std::printf(" %11.4g", r.physics->massProperties.mass);
@@ -363,7 +374,7 @@ int answerAgain(const QueryCommandOptions& o, const io::Database& db, const io::
                       {"seconds", learned->seconds}};
       q["after_learning"] = answerJson(*again);
     } else if (o.table) {
-      printTableRow(p.file + " (learned)", *again);
+      printTableRow(tableNameWidth(o.meshes, true), p.file + " (learned)", *again);
     } else {
       if (learned->computed)
         std::printf("%s: learned as entry %u '%s' in %.1f s; queried again:\n", p.file.c_str(), learned->id,
@@ -447,7 +458,7 @@ Status reportAnswer(const QueryCommandOptions& o, const LoadedFile& f, const cor
   if (o.json)
     queries.push_back(queryJson(f.file, f.loaded, mesh, f.repaired, r, o.descriptor));
   else if (o.table)
-    printTableRow(f.file, r);
+    printTableRow(tableNameWidth(o.meshes, o.enrich), f.file, r);
   else
     printText(f.file, mesh, r, o.timing);
   return Ok{};
@@ -476,7 +487,7 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   std::vector<PendingLearn> pending;
   nlohmann::json queries = nlohmann::json::array();
   int status = kExitOk;
-  if (o.table && !o.json) printTableHeader();
+  if (o.table && !o.json) printTableHeader(tableNameWidth(o.meshes, o.enrich));
   // A batch at a time, its queries spread over the cores (Database::queryMany), printed in the order given.
   for (std::size_t next = 0; next < o.meshes.size();) {
     std::vector<LoadedFile> batch;
@@ -546,7 +557,8 @@ Command addQueryCommand(CLI::App& parent) {
   app->add_option("--png", o->png, "Draw each query beside its match (several meshes: FILE-1.png, ...)");
   app->add_flag("--timing", o->timing, "Print the time of each stage (text output; JSON always has it)");
   app->add_flag("--table", o->table,
-                "One line per mesh: best match, fidelity, mass, first three frequencies");
+                "One line per mesh: best match, fidelity (mean surface deviation, largest moment error),\n"
+                "predicted first-frequency error, mass, first three frequencies");
   app->add_flag("--no-fidelity", o->noFidelity, "Skip the fidelity report (it fetches every match's tets)");
   app->add_flag("--approximate", o->approximate,
                 "Answer an open or non-manifold surface (a scan with holes) too: its mass properties from\n"

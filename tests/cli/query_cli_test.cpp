@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 #include <set>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -144,6 +145,26 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   ASSERT_EQ(text.exitCode, 0) << text.err;
   EXPECT_NE(text.out.find(b["matches"][0]["name"].get<std::string>()), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("timing (µs)"), std::string::npos) << text.out;
+
+  // --table: a header and a row per mesh, saying what the JSON says (the same material, aluminium).
+  test::ProcessResult table = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), box.string(), rod.string(), "--material", "aluminium", "--table"});
+  ASSERT_EQ(table.exitCode, 0) << table.err;
+  std::istringstream lines(table.out);
+  std::string header, row;
+  ASSERT_TRUE(std::getline(lines, header) && std::getline(lines, row)) << table.out;
+  EXPECT_NE(header.find("pred.err"), std::string::npos) << header;
+  std::istringstream cells(row);
+  std::string file, name, deviation, momentError, predicted;
+  double distance = 0.0, mass = 0.0, f1 = 0.0;
+  cells >> file >> name >> distance >> deviation >> momentError >> predicted >> mass >> f1;
+  EXPECT_EQ(file, "box.ply");
+  EXPECT_EQ(name, b["matches"][0]["name"].get<std::string>());
+  EXPECT_NEAR(distance, b["matches"][0]["distance"].get<double>(), 1e-4);
+  ASSERT_TRUE(b.contains("predicted_frequency_error")) << b;
+  EXPECT_NEAR(std::stod(predicted), 100.0 * b["predicted_frequency_error"].get<double>(), 0.005) << row;
+  EXPECT_NEAR(mass, p["mass"].get<double>(), 1e-3 * p["mass"].get<double>());
+  EXPECT_NEAR(f1, p["frequencies_hz"][0].get<double>(), 0.05);
 }
 
 // A closed mesh with holes punched in it is refused, with the flag that gets past it; with --repair it is
