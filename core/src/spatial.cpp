@@ -148,6 +148,31 @@ double rayBoxEntry(const Vec3& origin, const Vec3& direction, const Node& node, 
   return near <= far * (1.0 + 1e-12) + 1e-300 ? near : std::numeric_limits<double>::infinity();
 }
 
+/// A child waiting on a tree search's stack: a node (count 0) or a leaf's triangles, and its key (the
+/// squared distance to its box, or where a ray enters it).
+struct Pending {
+  std::uint32_t child, count;
+  double key;
+};
+// Each node popped pushes at most four: a tree over 2³² triangles is < 17 nodes deep.
+using SearchStack = std::array<Pending, 72>;
+
+/// Pushes the children of `node` whose key is finite, the smallest last so that it is taken first.
+template <class Node>
+void pushNearestLast(const Node& node, const std::array<double, 4>& keys, SearchStack& stack, int& top) {
+  std::array<Pending, 4> sorted;
+  int count = 0;
+  for (std::size_t c = 0; c < 4; ++c) {
+    if (!(keys[c] < std::numeric_limits<double>::infinity())) continue;
+    int at = count++;
+    for (; at > 0 && sorted[static_cast<std::size_t>(at - 1)].key < keys[c]; --at)
+      sorted[static_cast<std::size_t>(at)] = sorted[static_cast<std::size_t>(at - 1)];
+    sorted[static_cast<std::size_t>(at)] = {node.child[c], node.count[c], keys[c]};
+  }
+  for (int c = 0; c < count; ++c)
+    stack[static_cast<std::size_t>(top++)] = sorted[static_cast<std::size_t>(c)];
+}
+
 // The sizes of a node's children over n triangles: n halved, and each half over a leaf's size halved
 // again (the build's median splits), so that a node has two to four children.
 std::array<std::uint32_t, 4> childSizes(std::uint32_t n, int& count) {
@@ -314,18 +339,12 @@ ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p, std::uint32_t hin
 }
 
 ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double bestSq) const {
-  // A node (count 0) or a leaf's triangles, and the squared distance to its box.
-  struct Pending {
-    std::uint32_t child, count;
-    double boxSq;
-  };
-  // Each node popped pushes at most four: a tree over 2³² triangles is < 17 nodes deep.
-  std::array<Pending, 72> stack;
+  SearchStack stack;
   int top = 0;
-  stack[top++] = {0, 0, 0.0};
+  stack[static_cast<std::size_t>(top++)] = {0, 0, 0.0};
   while (top > 0) {
-    const Pending pending = stack[--top];
-    if (pending.boxSq >= bestSq) continue;
+    const Pending pending = stack[static_cast<std::size_t>(--top)];
+    if (pending.key >= bestSq) continue;
     if (pending.count > 0) {
       for (std::uint32_t i = pending.child; i < pending.child + pending.count; ++i) {
         const TrianglePoint q = closestOnTriangle(p, i);
@@ -336,21 +355,14 @@ ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double b
       }
       continue;
     }
-    const Node& node = mNodes[pending.child];
-    const Eigen::Array4d boxSq = boxSquaredDistances(p, node);
-    // The children that may hold a closer point, the nearest pushed last so that it is taken first.
-    std::array<Pending, 4> near;
-    int count = 0;
+    // The children that may hold a closer point.
+    const Eigen::Array4d boxSq = boxSquaredDistances(p, mNodes[pending.child]);
+    std::array<double, 4> keys;
     for (std::size_t c = 0; c < 4; ++c) {
       const double d = boxSq[static_cast<Eigen::Index>(c)];
-      if (!(d < bestSq)) continue;
-      int at = count++;
-      for (; at > 0 && near[static_cast<std::size_t>(at - 1)].boxSq < d; --at)
-        near[static_cast<std::size_t>(at)] = near[static_cast<std::size_t>(at - 1)];
-      near[static_cast<std::size_t>(at)] = {node.child[c], node.count[c], d};
+      keys[c] = d < bestSq ? d : std::numeric_limits<double>::infinity();
     }
-    for (int c = 0; c < count; ++c)
-      stack[top++] = near[static_cast<std::size_t>(c)];
+    pushNearestLast(mNodes[pending.child], keys, stack, top);
   }
   return best;
 }
@@ -383,16 +395,12 @@ std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3&
   if (mNodes.empty()) return best;
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   double bestDistance = kInfinity;
-  struct Pending {
-    std::uint32_t child, count;
-    double entry;  ///< where the ray enters its box
-  };
-  std::array<Pending, 72> stack;
+  SearchStack stack;
   int top = 0;
-  stack[top++] = {0, 0, minDistance};
+  stack[static_cast<std::size_t>(top++)] = {0, 0, minDistance};
   while (top > 0) {
-    const Pending pending = stack[--top];
-    if (pending.entry > bestDistance) continue;  // behind the best hit
+    const Pending pending = stack[static_cast<std::size_t>(--top)];
+    if (pending.key > bestDistance) continue;  // the ray enters its box behind the best hit
     if (pending.count > 0) {
       for (std::uint32_t i = pending.child; i < pending.child + pending.count; ++i) {
         if (mOrder[i] == skip) continue;
@@ -406,21 +414,14 @@ std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3&
       }
       continue;
     }
+    // The children the ray enters before the best hit.
     const Node& node = mNodes[pending.child];
-    // The children the ray enters before the best hit, the nearest pushed last.
-    std::array<Pending, 4> entered;
-    int count = 0;
-    for (std::size_t c = 0; c < 4; ++c) {
-      if (node.child[c] == Node::kNoChild) continue;
-      const double entry = rayBoxEntry(origin, direction, node, c, minDistance, bestDistance);
-      if (entry == kInfinity) continue;
-      int at = count++;
-      for (; at > 0 && entered[static_cast<std::size_t>(at - 1)].entry < entry; --at)
-        entered[static_cast<std::size_t>(at)] = entered[static_cast<std::size_t>(at - 1)];
-      entered[static_cast<std::size_t>(at)] = {node.child[c], node.count[c], entry};
-    }
-    for (int c = 0; c < count; ++c)
-      stack[top++] = entered[static_cast<std::size_t>(c)];
+    std::array<double, 4> keys;
+    for (std::size_t c = 0; c < 4; ++c)
+      keys[c] = node.child[c] == Node::kNoChild
+                    ? kInfinity
+                    : rayBoxEntry(origin, direction, node, c, minDistance, bestDistance);
+    pushNearestLast(node, keys, stack, top);
   }
   return best;
 }
