@@ -249,24 +249,36 @@ TEST(BuildCli, AnMpiBuildOnThreeRanksEqualsASingleBuildAndAKilledRankIsResumed) 
   EXPECT_NE(mpi.out.find("24 entries built"), std::string::npos) << mpi.out;
   expectSameEntries(dir / "mpi.db", dir / "single.db");
 
-  // A computing rank killed for real once a few batches are in: the job ends, what was committed stays,
-  // and a resumed build (on MPI again) finishes the same file.
+  // A computing rank killed for real once a batch is in: the job ends, what was committed stays, and a
+  // resumed build (on MPI again) finishes the same file. The other ranks go on until mpirun ends them
+  // (here a dozen more entries were committed meanwhile), so rank 1 is found before the batch is waited for,
+  // and a job that finished first on a loaded machine is run again rather than taken for a kill.
   const std::filesystem::path killed = dir / "killed.db";
   std::vector<std::string> argv = {"--oversubscribe", "-np",           "3",    SHAPEDB_CLI,
                                    "build",           killed.string(), "--mpi"};
   argv.insert(argv.end(), args.begin(), args.end());
-  test::RunningProcess job(SHAPEDB_MPIEXEC, argv);
-  ASSERT_TRUE(job.started());
-  ASSERT_TRUE(test::waitUntil([&] { return committedEntries(killed) >= 4; }, 120.0));
-  const pid_t worker = findRank(killed.string(), 1);
-  ASSERT_GT(worker, 0) << "rank 1 not found";
-  ASSERT_EQ(::kill(worker, SIGKILL), 0);
-  ASSERT_TRUE(test::waitUntil([&] { return findRank(killed.string(), 0) == 0; }, 60.0))
-      << "the job went on without rank 1";
-  job.kill();  // reaps mpirun, whatever it did
-  const std::size_t atKill = committedEntries(killed);
-  std::printf("rank 1 killed with %zu of 24 entries committed\n", atKill);
-  ASSERT_LT(atKill, 24u) << "the build finished before its rank was killed";
+  std::size_t atKill = 24;
+  for (int attempt = 0; attempt < 3 && atKill == 24; ++attempt) {
+    for (const char* suffix : {"", "-wal", "-shm"})
+      std::filesystem::remove(killed.string() + suffix);
+    test::RunningProcess job(SHAPEDB_MPIEXEC, argv);
+    ASSERT_TRUE(job.started());
+    pid_t worker = 0;
+    ASSERT_TRUE(test::waitUntil(
+        [&] {
+          if (worker == 0) worker = findRank(killed.string(), 1);
+          return worker > 0 && committedEntries(killed) >= 2;
+        },
+        120.0))
+        << "rank 1 not found, or no batch committed";
+    ASSERT_EQ(::kill(worker, SIGKILL), 0);
+    ASSERT_TRUE(test::waitUntil([&] { return findRank(killed.string(), 0) == 0; }, 60.0))
+        << "the job went on without rank 1";
+    job.kill();  // reaps mpirun, whatever it did
+    atKill = committedEntries(killed);
+    std::printf("rank 1 killed with %zu of 24 entries committed\n", atKill);
+  }
+  ASSERT_LT(atKill, 24u) << "the build finished before its rank was killed, three times";
   const test::ProcessResult resumed = runMpi(3, {"build", killed.string(), "--mpi", "--resume", "--quiet"});
   ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
   EXPECT_NE(resumed.out.find(std::to_string(atKill) + " already there"), std::string::npos) << resumed.out;
