@@ -350,8 +350,9 @@ struct PendingLearn {
 };
 
 /// query --enrich's second half: waits for each mesh to be learned, queries it again and prints both.
-int answerAgain(const QueryCommandOptions& o, const io::Database& db, const io::QueryOptions& options,
-                std::vector<PendingLearn>& pending, nlohmann::json& queries) {
+int answerAgain(const QueryCommandOptions& o, int nameWidth, const io::Database& db,
+                const io::QueryOptions& options, std::vector<PendingLearn>& pending,
+                nlohmann::json& queries) {
   int status = kExitOk;
   for (PendingLearn& p : pending) {
     const Result<io::Learned>& learned = p.learned.get();
@@ -374,7 +375,7 @@ int answerAgain(const QueryCommandOptions& o, const io::Database& db, const io::
                       {"seconds", learned->seconds}};
       q["after_learning"] = answerJson(*again);
     } else if (o.table) {
-      printTableRow(tableNameWidth(o.meshes, true), p.file + " (learned)", *again);
+      printTableRow(nameWidth, p.file + " (learned)", *again);
     } else {
       if (learned->computed)
         std::printf("%s: learned as entry %u '%s' in %.1f s; queried again:\n", p.file.c_str(), learned->id,
@@ -449,8 +450,8 @@ void submitToLearn(const QueryCommandOptions& o, io::Enricher& enricher, const L
 }
 
 /// One answer out: the files beside it (--export-obj, --png), then JSON, a table row or text.
-Status reportAnswer(const QueryCommandOptions& o, const LoadedFile& f, const core::TriangleMesh& mesh,
-                    const io::QueryResult& r, nlohmann::json& queries) {
+Status reportAnswer(const QueryCommandOptions& o, int nameWidth, const LoadedFile& f,
+                    const core::TriangleMesh& mesh, const io::QueryResult& r, nlohmann::json& queries) {
   if (!o.exportDir.empty())
     if (Status st = exportObj(o.exportDir, std::filesystem::path(f.file).stem().string(), r); !st) return st;
   if (!o.png.empty())
@@ -458,7 +459,7 @@ Status reportAnswer(const QueryCommandOptions& o, const LoadedFile& f, const cor
   if (o.json)
     queries.push_back(queryJson(f.file, f.loaded, mesh, f.repaired, r, o.descriptor));
   else if (o.table)
-    printTableRow(tableNameWidth(o.meshes, o.enrich), f.file, r);
+    printTableRow(nameWidth, f.file, r);
   else
     printText(f.file, mesh, r, o.timing);
   return Ok{};
@@ -487,7 +488,9 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
   std::vector<PendingLearn> pending;
   nlohmann::json queries = nlohmann::json::array();
   int status = kExitOk;
-  if (o.table && !o.json) printTableHeader(tableNameWidth(o.meshes, o.enrich));
+  // The table's name column, worked out once: it reads every file name given.
+  const int nameWidth = o.table ? tableNameWidth(o.meshes, o.enrich) : 0;
+  if (o.table && !o.json) printTableHeader(nameWidth);
   // A batch at a time, its queries spread over the cores (Database::queryMany), printed in the order given.
   for (std::size_t next = 0; next < o.meshes.size();) {
     std::vector<LoadedFile> batch;
@@ -502,14 +505,14 @@ int runQuery(const QueryCommandOptions& o, const CLI::App& app) {
         continue;
       }
       if (enricher) submitToLearn(o, *enricher, batch[b], meshes[b], *results[b], queries.size(), pending);
-      if (Status st = reportAnswer(o, batch[b], meshes[b], *results[b], queries); !st) {
+      if (Status st = reportAnswer(o, nameWidth, batch[b], meshes[b], *results[b], queries); !st) {
         printError(st.error().message);
         return kExitInputError;
       }
     }
   }
   if (enricher)
-    if (answerAgain(o, *db, options, pending, queries) != kExitOk) status = kExitInputError;
+    if (answerAgain(o, nameWidth, *db, options, pending, queries) != kExitOk) status = kExitInputError;
   if (o.json)
     std::printf("%s\n", nlohmann::json{{"database", o.database}, {"queries", queries}}.dump(2).c_str());
   return status;
