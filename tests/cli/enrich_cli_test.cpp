@@ -149,9 +149,15 @@ TEST(EnrichCli, HapticEnrichSwapsEachObjectsLearnedDataIntoTheLoop) {
   const auto json = nlohmann::json::parse(test::readFile(report));
   EXPECT_EQ(json["objects_augmented"], 2);
   EXPECT_EQ(json["objects_learned"], 2) << json.dump(2);
-  for (const auto& o : json["objects"]) {
+  ASSERT_EQ(json["objects"].size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto& o = json["objects"][i];
+    const auto& other = json["objects"][1 - i];
     EXPECT_EQ(o["entry"].get<std::string>().rfind("learned-", 0), 0u) << o.dump();
-    EXPECT_EQ(o["first_entry"].get<std::string>().rfind("box-", 0), 0u) << o.dump();
+    // First a box, or the other prism's learned entry where it was learned before this one was met (on a
+    // loaded machine the proxy can reach the second prism that late): never its own.
+    const std::string first = o["first_entry"];
+    EXPECT_TRUE(first.rfind("box-", 0) == 0 || first == other["entry"]) << json.dump(2);
     EXPECT_GT(o["learned_latency_ms"].get<double>(), o["augmentation_latency_ms"].get<double>());
   }
   EXPECT_EQ(learnedEntries(db), 2u);
