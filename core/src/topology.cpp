@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -156,6 +158,32 @@ Status requireClosedOriented(const TopologyReport& topology) {
                                                           plural(topology.inconsistentEdges, "edge") +
                                                           " traversed twice in the same direction)"};
   return Ok{};
+}
+
+std::vector<Shell> findShells(const TriangleMesh& mesh) {
+  DisjointSets sets(mesh.vertices.size());
+  for (const auto& t : mesh.triangles) {
+    sets.unite(t[0], t[1]);
+    sets.unite(t[0], t[2]);
+  }
+  std::vector<Shell> shells;
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> shellOf(mesh.vertices.size(), kNone);  // by a set's representative
+  std::vector<Vec3> origin;  // each shell's first vertex: its volume summed about a point of its own
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    std::uint32_t& shell = shellOf[sets.find(t[0])];
+    if (shell == kNone) {
+      shell = static_cast<std::uint32_t>(shells.size());
+      shells.emplace_back();
+      origin.push_back(mesh.vertices[t[0]]);
+    }
+    const Vec3& o = origin[shell];
+    const Vec3 a = mesh.vertices[t[0]] - o, b = mesh.vertices[t[1]] - o, c = mesh.vertices[t[2]] - o;
+    shells[shell].triangles.push_back(static_cast<std::uint32_t>(f));
+    shells[shell].volume += a.dot(b.cross(c)) / 6.0;
+  }
+  return shells;
 }
 
 MeshDefects findDefects(const TriangleMesh& mesh) {

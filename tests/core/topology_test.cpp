@@ -125,6 +125,43 @@ TEST(Topology, BucketedAnalysisAgreesWithTheGlobalSortOnRandomMeshes) {
   }
 }
 
+// Shells: each component's enclosed volume, signed by its winding. A hollow box (an inner box wound
+// inward) is a solid shell and a cavity whose volumes sum to the solid's; two boxes apart are two solids;
+// far from the origin the volumes are as exact (each is summed about a vertex of its own).
+TEST(Topology, ShellsAreSignedByTheirWinding) {
+  const auto append = [](TriangleMesh& to, const TriangleMesh& from, const Vec3& offset, bool inward) {
+    const auto first = static_cast<std::uint32_t>(to.vertices.size());
+    for (const Vec3& v : from.vertices)
+      to.vertices.push_back(v + offset);
+    for (const auto& t : from.triangles)
+      to.triangles.push_back(inward ? TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
+                                    : TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
+  };
+  for (const Vec3& far : {Vec3(0, 0, 0), Vec3(1e6, -2e6, 3e5)}) {
+    TriangleMesh hollow;
+    append(hollow, makeBox(Vec3(2, 2, 2)), far, false);
+    append(hollow, makeBox(Vec3(1, 1, 0.5)), far + Vec3(0.2, 0.1, 0.0), true);
+    const std::vector<Shell> shells = findShells(hollow);
+    ASSERT_EQ(shells.size(), 2u);
+    EXPECT_NEAR(shells[0].volume, 8.0, 1e-9);
+    EXPECT_NEAR(shells[1].volume, -0.5, 1e-9);
+    EXPECT_EQ(shells[0].triangles.size(), 12u);
+    EXPECT_EQ(shells[1].triangles.front(), 12u);
+
+    TriangleMesh apart;
+    append(apart, makeBox(Vec3(1, 1, 1)), far, false);
+    append(apart, makeBox(Vec3(1, 2, 1)), far + Vec3(3, 0, 0), false);
+    const std::vector<Shell> two = findShells(apart);
+    ASSERT_EQ(two.size(), 2u);
+    EXPECT_NEAR(two[0].volume, 1.0, 1e-9);
+    EXPECT_NEAR(two[1].volume, 2.0, 1e-9);
+  }
+  const std::vector<Shell> one = findShells(makeIcosphere(1.0, 2));
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].triangles.size(), 320u);
+  EXPECT_GT(one[0].volume, 4.0);  // a bit under 4π/3 = 4.19
+}
+
 TEST(Validate, AcceptsAGoodMesh) {
   EXPECT_TRUE(validateMesh(makeIcosphere(1.0, 2)).ok());
 }

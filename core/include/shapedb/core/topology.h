@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include <shapedb/core/result.h>
 #include <shapedb/core/triangle_mesh.h>
@@ -40,6 +42,19 @@ TopologyReport analyzeTopologyBySorting(const TriangleMesh& mesh);
 /// The error a mass-property computation should report for this topology, or Ok when the surface is
 /// closed and consistently oriented: "mesh is not closed (14 boundary edges)".
 Status requireClosedOriented(const TopologyReport& topology);
+
+/// One closed shell of a surface (a connected component: triangles sharing a vertex) and the volume it
+/// encloses, signed by its winding: positive where its triangles face outward (it bounds a solid of its
+/// own), negative where they face inward (a cavity: a void inside the solid around it, as in a hollow
+/// ball or a sealed tank modelled with its wall's two sides).
+struct Shell {
+  std::vector<std::uint32_t> triangles;  ///< indices into the mesh's triangles, ascending
+  double volume = 0.0;                   ///< signed, in the mesh's units cubed
+};
+
+/// The shells of `mesh`, in the order of their first triangle. Precondition: indices in range
+/// (validateMesh); the volumes mean what they say only for a closed, consistently oriented surface.
+std::vector<Shell> findShells(const TriangleMesh& mesh);
 
 /// What validateMesh tolerates.
 struct ValidationOptions {
