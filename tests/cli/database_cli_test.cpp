@@ -409,13 +409,14 @@ TEST(BuildCli, InfoAndAddEndToEnd) {
   EXPECT_NE(refused.err.find("[1/1] " + crossed.string() + ": failed, so none will be added"),
             std::string::npos)
       << refused.err;
-  // Two boxes apart, as one mesh: TetGen meshes them, but the tets make two pieces (they would ring at
-  // zero); refused, with the remeshing flag as what may get past it.
+  // Two boxes apart, as one mesh: two solids, where an entry is one (its tets would make two pieces,
+  // ringing at zero); refused, with the remeshing flag as what may get past it (solids that touch are one
+  // once remeshed as the solid they enclose together).
   const auto twoPieces = dir / "apart.obj";
   ASSERT_TRUE(io::saveMesh(test::twoUnitBoxes({3.0, 0.0, 0.0}), twoPieces).ok());
   test::ProcessResult pieces = test::runProcess(SHAPEDB_CLI, {"add", db.string(), twoPieces.string()});
   EXPECT_EQ(pieces.exitCode, 1);
-  EXPECT_NE(pieces.err.find("2 pieces"), std::string::npos) << pieces.err;
+  EXPECT_NE(pieces.err.find("2 separate solids"), std::string::npos) << pieces.err;
   EXPECT_NE(pieces.err.find("; --repair remeshes the surface as the solid it encloses"), std::string::npos)
       << pieces.err;
   test::ProcessResult after = test::runProcess(SHAPEDB_CLI, {"info", db.string(), "--json"});

@@ -361,6 +361,30 @@ TEST(Modal, FreeFreeBeamAtTheDefaultQuadraticMeshingMatchesEulerBernoulli) {
   }
 }
 
+// A hollow ball (its wall a fifth of its radius) rings well below the solid one of the same radius, as
+// a thick spherical shell should (its lowest mode bends the wall): the tets leave the cavity empty. Filled,
+// as TetGen fills a cavity it is not told of, the two would ring alike.
+TEST(Modal, AHollowBallRingsBelowTheSolidOne) {
+  const core::TriangleMesh solid = core::makeIcosphere(1.0, 3);
+  core::TriangleMesh hollow = solid;
+  const core::TriangleMesh inner = core::makeIcosphere(0.8, 3);
+  const auto first = static_cast<std::uint32_t>(hollow.vertices.size());
+  for (const Vec3& v : inner.vertices)
+    hollow.vertices.push_back(v);
+  for (const auto& t : inner.triangles)  // wound inward: a cavity
+    hollow.triangles.push_back({t[0] + first, t[2] + first, t[1] + first});
+  const ModalOptions options{.modes = 3, .material = core::unitMaterial(0.3)};
+  const TetMesh solidTets = tetsOrDie(solid, {.maxVolumeFraction = 1.0 / 300.0});
+  const TetMesh hollowTets = tetsOrDie(hollow, {.maxVolumeFraction = 1.0 / 300.0});
+  Result<core::ModalData> a = computeModes(solidTets, options);
+  Result<core::ModalData> b = computeModes(hollowTets, options);
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  EXPECT_LT(b->eigenvalues[0], 0.5 * a->eigenvalues[0]);  // frequencies: below 0.71 of the solid's
+  EXPECT_NEAR(core::computeTetMassProperties(hollowTets).volume, core::computeMassProperties(hollow)->volume,
+              1e-9);
+}
+
 TEST(Modal, DisconnectedSolidIsAnError) {
   // Two separate cubes: twelve rigid modes, not six.
   TetMesh a = tetsOrDie(core::makeBox(Vec3(1, 1, 1)));

@@ -157,6 +157,59 @@ TEST(Tetrahedralize, GuardedAndInProcessGiveTheSameMesh) {
     ASSERT_EQ(guarded.nodes[i], local.nodes[i]);
 }
 
+/// `inner` appended to `outer`, moved by `offset` and wound inward when `cavity` (a void in the solid).
+core::TriangleMesh withShell(core::TriangleMesh outer, const core::TriangleMesh& inner, const Vec3& offset,
+                             bool cavity) {
+  const auto first = static_cast<std::uint32_t>(outer.vertices.size());
+  for (const Vec3& v : inner.vertices)
+    outer.vertices.push_back(v + offset);
+  for (const auto& t : inner.triangles)
+    outer.triangles.push_back(cavity
+                                  ? core::TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
+                                  : core::TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
+  return outer;
+}
+
+// A solid with cavities (inner shells wound inward: a hollow casting, a sealed tank modelled with both
+// sides of its wall): TetGen fills a cavity as it fills the solid unless told where it is, and the fill
+// check then refused the mesh. The cavities are left empty now: the tets hold the solid's volume and
+// none lies in a cavity, guarded or not (the hole points cross to the worker).
+TEST(Tetrahedralize, ACavityIsLeftEmpty) {
+  core::TriangleMesh hollow =
+      withShell(core::makeBox(Vec3(2, 1.5, 1)), core::makeBox(Vec3(1, 0.8, 0.5)), Vec3(0.3, 0.1, 0.0), true);
+  hollow = withShell(std::move(hollow), core::makeUvEllipsoid(Vec3(0.15, 0.15, 0.15), 12, 6),
+                     Vec3(-0.6, 0.0, 0.0), true);
+  const double solid =
+      3.0 - 0.4 - core::computeMassProperties(core::makeUvEllipsoid(Vec3(0.15, 0.15, 0.15), 12, 6))->volume;
+  for (bool guarded : {true, false}) {
+    const TetMesh tets = meshOrDie(hollow, {.maxVolumeFraction = 1.0 / 300.0, .guarded = guarded});
+    ASSERT_TRUE(core::validateTetMesh(tets).ok());
+    EXPECT_NEAR(core::computeTetMassProperties(tets).volume, solid, 1e-9 * solid);
+    for (std::size_t t = 0; t < tets.tetCount(); ++t) {
+      const Vec3 c = 0.25 * (tets.nodes[tets.tets[t][0]] + tets.nodes[tets.tets[t][1]] +
+                             tets.nodes[tets.tets[t][2]] + tets.nodes[tets.tets[t][3]]);
+      const Vec3 inBox = (c - Vec3(0.3, 0.1, 0.0)).cwiseAbs();
+      ASSERT_FALSE(inBox.x() < 0.5 && inBox.y() < 0.4 && inBox.z() < 0.25) << "tet " << t << " in the cavity";
+      ASSERT_GT((c - Vec3(-0.6, 0.0, 0.0)).norm(), 0.1) << "tet " << t << " in the ball's cavity";
+    }
+  }
+}
+
+// A surface of several solids (closed shells, none a cavity of another: two boxes apart, or a ball
+// loose inside a hollow one) is not one tet mesh: refused up front, with their count.
+TEST(Tetrahedralize, SeparateSolidsAreRefusedWithTheirCount) {
+  const core::TriangleMesh apart =
+      withShell(core::makeBox(Vec3(1, 1, 1)), core::makeBox(Vec3(1, 1, 1)), Vec3(3, 0, 0), false);
+  const core::TriangleMesh rattle = withShell(
+      withShell(core::makeBox(Vec3(2, 2, 2)), core::makeBox(Vec3(1.5, 1.5, 1.5)), Vec3::Zero(), true),
+      core::makeUvEllipsoid(Vec3(0.3, 0.3, 0.3), 12, 6), Vec3::Zero(), false);
+  for (const core::TriangleMesh& surface : {apart, rattle}) {
+    const Result<TetMesh> tets = tetrahedralize(surface);
+    ASSERT_FALSE(tets.ok());
+    EXPECT_NE(tets.error().message.find("2 separate solids"), std::string::npos) << tets.error().message;
+  }
+}
+
 // A worker that dies (or hangs) costs its request only: the same request is repeated in a fresh worker,
 // and the mesh is the one a healthy worker gives. These boxes are the first of the catalog a build of 24
 // entries makes; for them the run without facet merging, which used to follow a dead worker, gives

@@ -48,7 +48,7 @@ bool overLocalVolumeBound(REAL* a, REAL* b, REAL* c, REAL* d, REAL* /*elen*/, RE
 }  // namespace
 
 TetGenOutput runTetGen(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
-                       const std::string& switches) {
+                       const std::vector<core::Vec3>& holes, const std::string& switches) {
   tetgenio in, out;
   in.firstnumber = 0;
   in.numberofpoints = static_cast<int>(surface.vertices.size());
@@ -61,6 +61,13 @@ TetGenOutput runTetGen(const TriangleMesh& surface, const std::vector<double>& m
     tree = core::ClosestPointTree(surface);
     tLocalBound = {&tree, &maxVolumes};
     in.tetunsuitable = &overLocalVolumeBound;
+  }
+  if (!holes.empty()) {
+    in.numberofholes = static_cast<int>(holes.size());
+    in.holelist = new REAL[3 * holes.size()];
+    for (std::size_t i = 0; i < holes.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        in.holelist[3 * i + static_cast<std::size_t>(k)] = holes[i][k];
   }
   in.numberoffacets = static_cast<int>(surface.triangles.size());
   in.facetlist = new tetgenio::facet[surface.triangles.size()];
@@ -145,27 +152,30 @@ bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline,
   return true;
 }
 
-/// The child's side: requests in (switches, vertices, triangles, local volume bounds), TetGenOutputs out,
-/// until the parent closes the socket. Never returns.
+/// The child's side: requests in (switches, vertices, triangles, local volume bounds, hole points),
+/// TetGenOutputs out, until the parent closes the socket. Never returns.
 [[noreturn]] void serveTetGen(int fd) {
   const Deadline never = std::chrono::steady_clock::time_point::max();
   for (;;) {
     bool timedOut = false;
-    std::uint64_t header[4];  // switches length, vertex count, triangle count, local bound count
+    // switches length, vertex count, triangle count, local bound count, hole count
+    std::uint64_t header[5];
     if (!receiveAll(fd, header, sizeof header, never, timedOut)) ::_exit(0);
     std::string switches(header[0], '\0');
     TriangleMesh surface;
     surface.vertices.resize(header[1]);
     surface.triangles.resize(header[2]);
     std::vector<double> maxVolumes(header[3]);
+    std::vector<core::Vec3> holes(header[4]);
     if (!receiveAll(fd, switches.data(), switches.size(), never, timedOut) ||
         !receiveAll(fd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3), never,
                     timedOut) ||
         !receiveAll(fd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle),
                     never, timedOut) ||
-        !receiveAll(fd, maxVolumes.data(), maxVolumes.size() * sizeof(double), never, timedOut))
+        !receiveAll(fd, maxVolumes.data(), maxVolumes.size() * sizeof(double), never, timedOut) ||
+        !receiveAll(fd, holes.data(), holes.size() * sizeof(core::Vec3), never, timedOut))
       ::_exit(1);
-    const TetGenOutput raw = runTetGen(surface, maxVolumes, switches);
+    const TetGenOutput raw = runTetGen(surface, maxVolumes, holes, switches);
     const std::int64_t reply[3] = {raw.status, static_cast<std::int64_t>(raw.nodes.size()),
                                    static_cast<std::int64_t>(raw.tets.size())};
     if (!sendAll(fd, reply, sizeof reply) ||
@@ -184,15 +194,16 @@ class TetGenWorker {
   ~TetGenWorker() { stop(); }
 
   Result<TetGenOutput> run(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
-                           const std::string& switches, double timeout) {
+                           const std::vector<core::Vec3>& holes, const std::string& switches,
+                           double timeout) {
     if (mPid <= 0)
       if (Status st = start(); !st) return st.error();
     if (takeInjectedKill()) ::kill(mPid, SIGKILL);
     const Deadline deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(timeout));
-    const std::uint64_t header[4] = {switches.size(), surface.vertices.size(), surface.triangles.size(),
-                                     maxVolumes.size()};
+    const std::uint64_t header[5] = {switches.size(), surface.vertices.size(), surface.triangles.size(),
+                                     maxVolumes.size(), holes.size()};
     bool timedOut = false;
     std::int64_t reply[3] = {0, 0, 0};
     bool ok =
@@ -200,6 +211,7 @@ class TetGenWorker {
         sendAll(mFd, surface.vertices.data(), surface.vertices.size() * sizeof(core::Vec3)) &&
         sendAll(mFd, surface.triangles.data(), surface.triangles.size() * sizeof(TriangleMesh::Triangle)) &&
         sendAll(mFd, maxVolumes.data(), maxVolumes.size() * sizeof(double)) &&
+        sendAll(mFd, holes.data(), holes.size() * sizeof(core::Vec3)) &&
         receiveAll(mFd, reply, sizeof reply, deadline, timedOut);
     TetGenOutput raw;
     if (ok && reply[1] >= 0 && reply[2] >= 0 && reply[1] < (std::int64_t{1} << 34) &&
@@ -277,9 +289,10 @@ class TetGenWorker {
 }  // namespace
 
 Result<TetGenOutput> runTetGenGuarded(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
-                                      const std::string& switches, double timeout) {
+                                      const std::vector<core::Vec3>& holes, const std::string& switches,
+                                      double timeout) {
   thread_local TetGenWorker worker;
-  return worker.run(surface, maxVolumes, switches, timeout);
+  return worker.run(surface, maxVolumes, holes, switches, timeout);
 }
 
 /// TetGen's error codes (terminatetetgen in tetgen.cxx).

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -90,20 +91,73 @@ Status fillsSurface(const TetMesh& mesh, const core::MassProperties& mass) {
   return Ok{};
 }
 
+/// The surface's closed shells sorted by what they bound, for a surface wound outward: the solids (shells
+/// wound as the whole surface is) and the cavities (the others: voids inside a solid).
+struct Shells {
+  std::size_t solids = 0;
+  /// A point inside each cavity, for TetGen's hole list: TetGen fills a cavity with tets as it fills the
+  /// solid around it (it removes only what lies outside the outer shell), and removes those of a region
+  /// given a point in it. The point: from the centroid of the cavity's largest triangle, along the
+  /// triangle's normal (into the void), halfway to the next triangle the ray meets.
+  std::vector<core::Vec3> holes;
+};
+
+Result<Shells> findShells(const TriangleMesh& surface, double volume) {
+  Shells out;
+  const std::vector<core::Shell> shells = core::findShells(surface);
+  if (shells.size() == 1) {
+    out.solids = 1;
+    return out;
+  }
+  std::optional<core::ClosestPointTree> tree;
+  for (const core::Shell& shell : shells) {
+    if ((shell.volume > 0.0) == (volume > 0.0)) {
+      ++out.solids;
+      continue;
+    }
+    std::uint32_t largest = shell.triangles.front();
+    double largestArea = -1.0;
+    core::Vec3 normal = core::Vec3::Zero();
+    for (std::uint32_t t : shell.triangles) {
+      const TriangleMesh::Triangle& tri = surface.triangles[t];
+      const core::Vec3 n = (surface.vertices[tri[1]] - surface.vertices[tri[0]])
+                               .cross(surface.vertices[tri[2]] - surface.vertices[tri[0]]);
+      if (n.norm() > largestArea) {
+        largestArea = n.norm();
+        largest = t;
+        normal = n;
+      }
+    }
+    const TriangleMesh::Triangle& tri = surface.triangles[largest];
+    const core::Vec3 centroid =
+        (surface.vertices[tri[0]] + surface.vertices[tri[1]] + surface.vertices[tri[2]]) / 3.0;
+    if (!tree) tree.emplace(surface);
+    // Wound against the surface: its normal points into the void when the surface's points out of the solid.
+    const core::Vec3 into = (volume > 0.0 ? 1.0 : -1.0) * normal.normalized();
+    const std::optional<core::RayHit> hit = tree->firstHit(centroid, into, 0.0, largest);
+    if (!(largestArea > 0.0) || !hit || !(hit->distance > 0.0))
+      return Error{ErrorCode::kParse, "a cavity of the solid (a closed shell wound inward, " +
+                                          std::to_string(shell.triangles.size()) +
+                                          " triangles) has no inside to find: is it flat?"};
+    out.holes.push_back(centroid + 0.5 * hit->distance * into);
+  }
+  return out;
+}
+
 /// One TetGen run with these switches, its output checked and turned positive, and checked to fill the
 /// surface: same volume and centroid to 1e-9 (relative).
 Result<TetMesh> tetrahedralizeOnce(const TriangleMesh& surface, const std::vector<double>& wallBounds,
-                                   const TetrahedralizeOptions& options, const core::MassProperties& mass,
-                                   bool mergeFacets) {
+                                   const std::vector<core::Vec3>& holes, const TetrahedralizeOptions& options,
+                                   const core::MassProperties& mass, bool mergeFacets) {
   const double volume = mass.volume;
   const std::string switches = tetgenSwitches(options, volume, mergeFacets);
   detail::TetGenOutput raw;
   if (options.guarded) {
-    auto guarded = detail::runTetGenGuarded(surface, wallBounds, switches, options.timeoutSeconds);
+    auto guarded = detail::runTetGenGuarded(surface, wallBounds, holes, switches, options.timeoutSeconds);
     if (!guarded) return guarded.error();
     raw = std::move(guarded).value();
   } else {
-    raw = detail::runTetGen(surface, wallBounds, switches);
+    raw = detail::runTetGen(surface, wallBounds, holes, switches);
   }
   if (raw.status != 0) return Error{ErrorCode::kParse, detail::describeTetGenError(raw.status)};
 
@@ -152,6 +206,8 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // Per triangle: the same for every run below, the turned surface's included (its triangles are these,
   // and its volume bounds the same).
   const std::vector<double> wallBounds = wallVolumeBounds(surface, options, mass->volume);
+  auto shells = findShells(surface, mass->volume);
+  if (!shells) return shells.error();
 
   // TetGen merges adjacent facets it finds nearly coplanar, which moves a surface whose facets are only
   // nearly so (a simplified level-set mesh: the volume changed by 1e-6), or aborts on it. Such a run is
@@ -161,18 +217,19 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // fresh worker, so that a broken worker never changes the mesh. (Under ASan on a loaded machine a
   // worker hung until its timeout now and then; the unmerged run that followed gave another mesh, and a
   // resumed database differed from a clean one.)
-  auto once = [&wallBounds](const TriangleMesh& input, const core::MassProperties& inputMass,
-                            const TetrahedralizeOptions& o, bool mergeFacets) {
-    Result<TetMesh> result = tetrahedralizeOnce(input, wallBounds, o, inputMass, mergeFacets);
+  auto once = [&wallBounds](const TriangleMesh& input, const std::vector<core::Vec3>& holes,
+                            const core::MassProperties& inputMass, const TetrahedralizeOptions& o,
+                            bool mergeFacets) {
+    Result<TetMesh> result = tetrahedralizeOnce(input, wallBounds, holes, o, inputMass, mergeFacets);
     if (!result && result.error().code == ErrorCode::kIo && o.guarded && o.relaxOnFailure)
-      result = tetrahedralizeOnce(input, wallBounds, o, inputMass, mergeFacets);
+      result = tetrahedralizeOnce(input, wallBounds, holes, o, inputMass, mergeFacets);
     return result;
   };
-  auto attemptOn = [&](const TriangleMesh& input, const core::MassProperties& inputMass,
-                       const TetrahedralizeOptions& o) {
-    Result<TetMesh> result = once(input, inputMass, o, /*mergeFacets=*/true);
+  auto attemptOn = [&](const TriangleMesh& input, const std::vector<core::Vec3>& holes,
+                       const core::MassProperties& inputMass, const TetrahedralizeOptions& o) {
+    Result<TetMesh> result = once(input, holes, inputMass, o, /*mergeFacets=*/true);
     if (!result) {
-      Result<TetMesh> unmerged = once(input, inputMass, o, /*mergeFacets=*/false);
+      Result<TetMesh> unmerged = once(input, holes, inputMass, o, /*mergeFacets=*/false);
       if (unmerged) return unmerged;
       // Both said why: the merged run often only that merging moved the surface, the unmerged one what is
       // wrong with the tets themselves (a CAD part whose two lobes meet along an edge: two pieces).
@@ -183,7 +240,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     }
     return result;
   };
-  auto attempt = [&](const TetrahedralizeOptions& o) { return attemptOn(surface, *mass, o); };
+  auto attempt = [&](const TetrahedralizeOptions& o) { return attemptOn(surface, shells->holes, *mass, o); };
   Result<TetMesh> tets = attempt(options);
   if (tets) return tets;
   // A surface that passes through itself bounds no solid: TetGen refuses it or crashes on it (a scanned
@@ -192,6 +249,14 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   if (const std::vector<core::TriangleCrossing> crossings = core::findSelfIntersections(surface);
       !crossings.empty())
     return Error{ErrorCode::kSelfIntersecting, selfIntersectionMessage(crossings, tets.error())};
+  // Several solids (closed shells wound outward, none crossing another) are meshed, and refused as
+  // pieces: said as what they are. Looked for only now, after the crossings, since shells that cross
+  // (two overlapping boxes) count as two as well.
+  if (shells->solids > 1)
+    return Error{ErrorCode::kParse,
+                 "the surface bounds " + std::to_string(shells->solids) +
+                     " separate solids (closed shells, none a cavity of another): a tet mesh is of one "
+                     "solid, so give each its own mesh"};
   if (!options.relaxOnFailure) return tets;
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
   // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
@@ -215,7 +280,10 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     v = turn * v;
   const auto turnedMass = core::computeMassProperties(turned);
   if (!turnedMass) return tets;
-  Result<TetMesh> turnedTets = attemptOn(turned, *turnedMass, options);
+  std::vector<core::Vec3> turnedHoles = shells->holes;
+  for (core::Vec3& h : turnedHoles)
+    h = turn * h;
+  Result<TetMesh> turnedTets = attemptOn(turned, turnedHoles, *turnedMass, options);
   if (!turnedTets) return tets;
   TetMesh back = std::move(turnedTets).value();
   if (back.nodes.size() < surface.vertices.size()) return tets;
