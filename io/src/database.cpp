@@ -412,6 +412,18 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   Clock::time_point t = Clock::now();
   if (Status valid = core::validateMesh(mesh); !valid) return valid.error();
   const core::TopologyReport topology = core::analyzeTopology(mesh);
+  // A surface of several shells: separate solids, or cavities inside one (only a closed, oriented one
+  // says which). The entries the catalog generates are one solid each, without cavities.
+  std::size_t solids = 1, cavities = 0;
+  if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented()) {
+    const std::vector<core::Shell> shells = core::findShells(mesh);
+    double total = 0.0;
+    for (const core::Shell& shell : shells)
+      total += shell.volume;
+    solids = 0;
+    for (const core::Shell& shell : shells)
+      ++((shell.volume > 0.0) == (total > 0.0) ? solids : cavities);
+  }
   out.times.validate = microsecondsSince(t);
 
   t = Clock::now();
@@ -535,6 +547,21 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     out.physics = std::move(adapted).value();
     out.physics->warnings.insert(out.physics->warnings.end(), correctionWarnings.begin(),
                                  correctionWarnings.end());
+    const bool generated = out.answeredMatch().entry &&
+                           out.answeredMatch().entry->family != volume::Family::kUser &&
+                           out.answeredMatch().entry->family != volume::Family::kLearned;
+    if (solids > 1)
+      out.physics->warnings.push_back("the surface is " + std::to_string(solids) +
+                                      " closed shells wound outward (separate solids, or parts that touch or "
+                                      "overlap), not one: the answer "
+                                      "is one body's, as if they were joined, and may be far off; a mesh of "
+                                      "each solid gets its own data");
+    if (cavities > 0 && generated)
+      out.physics->warnings.push_back(
+          "the surface encloses " + std::to_string(cavities) + (cavities == 1 ? " cavity" : " cavities") +
+          " (a closed shell wound inward: the solid is hollow there), which the catalog's entries do not "
+          "have: the answer is of a body without them and may be far off; the object's own data, computed "
+          "with them, come from enrichment");
     if (out.massProperties.isApproximate)
       out.physics->warnings.push_back(
           "approximate: the surface bounds no well-defined solid, so its mass, centre and inertia are "
@@ -568,7 +595,13 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
         evidence.massScale = out.correction->massScale;
         evidence.strayShare = out.correction->strayShare;
       }
-      out.predictedFrequencyError = core::predictFrequencyError(evidence);
+      // The model was fitted on single solids without cavities: outside them it has nothing to say (and an
+      // unknown error is one enrichment learns from).
+      const bool generated = out.answeredMatch().entry &&
+                             out.answeredMatch().entry->family != volume::Family::kUser &&
+                             out.answeredMatch().entry->family != volume::Family::kLearned;
+      if (solids == 1 && (cavities == 0 || !generated))
+        out.predictedFrequencyError = core::predictFrequencyError(evidence);
     }
   }
   out.times.total = microsecondsSince(start);

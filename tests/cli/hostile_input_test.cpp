@@ -94,6 +94,16 @@ std::vector<Case> corpus() {
       EXPECT_NEAR(q["physics"]["mass"].get<double>(), expected, 1e-5 * expected);  // steel, the default
     };
   };
+  // A query answered with this among its warnings, and without a predicted error.
+  auto warns = [](std::string what) {
+    return [what](const nlohmann::json& q) {
+      bool found = false;
+      for (const auto& w : q["physics"]["warnings"])
+        found = found || w.get<std::string>().find(what) != std::string::npos;
+      EXPECT_TRUE(found) << "no warning with '" << what << "' in " << q["physics"]["warnings"].dump();
+      EXPECT_FALSE(q.contains("predicted_frequency_error"));
+    };
+  };
   return {
       // Files that are not what they say.
       {"empty.obj", [] { return std::string(); }, "file is empty"},
@@ -203,7 +213,14 @@ std::vector<Case> corpus() {
        [=] {
          return test::objText(merged(blob, translated(blob, {1.0, 0.0, 0.0})));
        },
-       "", nullptr},
+       "", warns("2 closed shells wound outward")},
+      // A hollow solid: the outer blob and a smaller one wound inward inside it (a cavity).
+      {"hollow_blob.obj",
+       [=] {
+         const TriangleMesh inner = scaled(blob, 0.5);
+         return test::objText(merged(blob, reversed(inner, inner.triangles.size())));
+       },
+       "", warns("encloses 1 cavity")},
       // Text oddities: CRLF line ends, a 4 MB comment line.
       {"crlf.obj",
        [=] {

@@ -899,6 +899,68 @@ TEST(Database, AddedMeshesAreFoundAndAnOpenOneIsRefusedWithNothingWritten) {
   EXPECT_EQ(Database::open(path)->entries().size(), 3u);
 }
 
+// A hollow object (a cavity: an inner shell wound inward) and two solids in one mesh: the catalog's
+// entries are single solids without cavities, so the answer says what it is of and carries no predicted
+// error (the error model knows single solids only; an unknown error is one enrichment learns from). Added
+// to the database, the hollow object is meshed with its cavity empty, and it then answers for itself
+// with a prediction and without the warning.
+TEST(Database, CavitiesAndSeparateSolidsAreSaidAndLearnedObjectsKeepTheirCavities) {
+  test::ScratchDir dir("database-shells");
+  const auto path = dir / "a.db";
+  ASSERT_TRUE(buildDatabase(path, smallBuild(2, {volume::Family::kBox}, 2)).ok());
+  const auto shellOf = [](core::TriangleMesh outer, const core::TriangleMesh& inner, const core::Vec3& offset,
+                          bool cavity) {
+    const auto first = static_cast<std::uint32_t>(outer.vertices.size());
+    for (const core::Vec3& v : inner.vertices)
+      outer.vertices.push_back(v + offset);
+    for (const auto& t : inner.triangles)
+      outer.triangles.push_back(cavity
+                                    ? core::TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
+                                    : core::TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
+    return outer;
+  };
+  const core::TriangleMesh box = core::makeBox(core::Vec3(1.0, 0.8, 0.6));
+  const core::TriangleMesh hollow =
+      shellOf(box, core::makeBox(core::Vec3(0.7, 0.5, 0.3)), core::Vec3::Zero(), true);
+  const core::TriangleMesh apart = shellOf(box, box, core::Vec3(2.0, 0.0, 0.0), false);
+  QueryOptions options;
+  options.fidelity = true;
+  options.link = true;
+  const auto warned = [](const QueryResult& r, const std::string& what) {
+    return std::any_of(r.physics->warnings.begin(), r.physics->warnings.end(),
+                       [&](const std::string& w) { return w.find(what) != std::string::npos; });
+  };
+  {
+    auto db = Database::open(path);
+    ASSERT_TRUE(db.ok()) << db.error().message;
+    auto single = db->query(box, options);
+    ASSERT_TRUE(single.ok() && single->physics) << (single ? "" : single.error().message);
+    EXPECT_TRUE(single->predictedFrequencyError.has_value());
+    EXPECT_FALSE(warned(*single, "cavit"));
+    auto h = db->query(hollow, options);
+    ASSERT_TRUE(h.ok() && h->physics) << (h ? "" : h.error().message);
+    EXPECT_TRUE(warned(*h, "encloses 1 cavity"));
+    EXPECT_FALSE(h->predictedFrequencyError.has_value());
+    auto two = db->query(apart, options);
+    ASSERT_TRUE(two.ok() && two->physics) << (two ? "" : two.error().message);
+    EXPECT_TRUE(warned(*two, "2 closed shells wound outward"));
+    EXPECT_FALSE(two->predictedFrequencyError.has_value());
+  }
+  auto ids = addToDatabase(path, std::vector<NamedMesh>{{"hollow.obj", "hollow.obj", hollow}});
+  ASSERT_TRUE(ids.ok()) << ids.error().message;
+  auto db = Database::open(path);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  auto physics = db->physics(ids->front());
+  ASSERT_TRUE(physics.ok()) << physics.error().message;
+  // In the entry's canonical frame the solid has unit volume: with the cavity filled, 0.48 / 0.375 of it.
+  EXPECT_NEAR(core::computeTetMassProperties((*physics)->tetMesh).volume, 1.0, 1e-6);
+  auto h = db->query(hollow, options);
+  ASSERT_TRUE(h.ok() && h->physics) << (h ? "" : h.error().message);
+  EXPECT_EQ(h->answeredMatch().match.entry, ids->front());
+  EXPECT_FALSE(warned(*h, "cavit"));
+  EXPECT_TRUE(h->predictedFrequencyError.has_value());
+}
+
 }  // namespace
 }  // namespace shapedb::io
 

@@ -129,7 +129,9 @@ struct QueryResult {
   core::SurfaceLink link;  ///< with QueryOptions::link
   /// With fidelity, adapt and link: how wrong the answer's first non-rigid frequency probably is
   /// (core/error_model.h; 0.1 is 10 %), from the answered match's fidelity report, the share of the query's
-  /// vertices outside its tets and, corrected, the morph's remaining distance.
+  /// vertices outside its tets and, corrected, the morph's remaining distance. None for a surface of
+  /// several solids, or with cavities answered by a generated entry: the model was fitted on single solids
+  /// without cavities (physics->warnings says which).
   std::optional<double> predictedFrequencyError;
   std::size_t orientationCandidates = 0;  ///< descriptors searched (orientations)
   QueryTimes times;
