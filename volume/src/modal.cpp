@@ -220,8 +220,12 @@ Result<ModalData> makeModalData(const Eigen::VectorXd& eigenvalues, const Eigen:
     if (zeros == 6)
       return Error{ErrorCode::kParse, std::string("the first non-rigid eigenvalue is not positive") + detail +
                                           ": degenerate or inverted tets?"};
-    return Error{ErrorCode::kParse, "expected six rigid modes, found " + std::to_string(zeros) +
-                                        " zero eigenvalues (is the solid in one piece?)" + detail};
+    return Error{
+        ErrorCode::kParse,
+        "expected six rigid modes, found " + std::to_string(zeros) +
+            " zero eigenvalues (a solid in more than one piece, a part its tets hold too loosely to "
+            "resist moving, or a body so slender that its first modes are under 1e-10 of its stiffest)" +
+            detail};
   }
   ModalData data;
   data.poissonRatio = options.material.poissonRatio;
