@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <tuple>
+#include <unordered_map>
 #include <vector>
 
 #include <shapedb/core/disjoint_sets.h>
@@ -158,6 +160,59 @@ Status requireClosedOriented(const TopologyReport& topology) {
                                                           plural(topology.inconsistentEdges, "edge") +
                                                           " traversed twice in the same direction)"};
   return Ok{};
+}
+
+std::size_t flipZeroAreaFaces(TriangleMesh& mesh) {
+  const auto key = [](std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; };
+  std::size_t flipped = 0;
+  // A pass flips each zero-area face it can, touching each triangle once; the next pass sees the edges
+  // the last one made (a second filler on the same edge flips against the first one's result).
+  for (bool progress = true; progress;) {
+    progress = false;
+    std::unordered_map<std::uint64_t, std::uint32_t> triangleOf;  // directed edge → its triangle
+    triangleOf.reserve(3 * mesh.triangles.size());
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        triangleOf.emplace(key(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]), t);
+    std::vector<char> touched(mesh.triangles.size(), 0);
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      if (touched[t] || hasRepeatedVertex(mesh.triangles[t]) || !hasZeroArea(mesh, mesh.triangles[t]))
+        continue;
+      // The middle corner is the one across the longest edge: the face is (a, b, m), wound a → b → m.
+      const TriangleMesh::Triangle& f = mesh.triangles[t];
+      int middle = 0;
+      double longest = -1.0;
+      for (int k = 0; k < 3; ++k) {
+        const double length = (mesh.vertices[f[(k + 1) % 3]] - mesh.vertices[f[(k + 2) % 3]]).squaredNorm();
+        if (length > longest) {
+          longest = length;
+          middle = k;
+        }
+      }
+      if (!(longest > 0.0)) continue;  // coincident corners: the weld's to merge, not a flip's
+      const std::uint32_t m = f[middle], a = f[(middle + 1) % 3], b = f[(middle + 2) % 3];
+      const auto across = triangleOf.find(key(b, a));
+      if (across == triangleOf.end() || across->second == t || touched[across->second]) continue;
+      const std::uint32_t u = across->second;
+      const TriangleMesh::Triangle& g = mesh.triangles[u];
+      const std::uint32_t x = g[0] != a && g[0] != b ? g[0] : g[1] != a && g[1] != b ? g[1] : g[2];
+      if (x == m || triangleOf.contains(key(m, x)) || triangleOf.contains(key(x, m))) continue;
+      const TriangleMesh::Triangle first{m, a, x}, second{x, b, m};
+      if (hasZeroArea(mesh, first) || hasZeroArea(mesh, second)) continue;
+      mesh.triangles[t] = first;
+      mesh.triangles[u] = second;
+      // The map follows, so that a later flip of this pass sees the edge m–x made here.
+      triangleOf.erase(key(a, b));
+      triangleOf.erase(key(b, a));
+      for (const auto& [from, to, in] :
+           {std::tuple{m, a, t}, {a, x, t}, {x, m, t}, {x, b, u}, {b, m, u}, {m, x, u}})
+        triangleOf[key(from, to)] = in;
+      touched[t] = touched[u] = 1;
+      ++flipped;
+      progress = true;
+    }
+  }
+  return flipped;
 }
 
 std::vector<Shell> findShells(const TriangleMesh& mesh) {

@@ -238,7 +238,13 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   out.polygonsTriangulated = tri.polygons;
   out.facesDropped = tri.tooFewCorners;
   out.defects = core::findDefects(out.mesh);
-  if (Status valid = core::checkDefects(out.defects, {.allowDegenerateFaces = options.allowDegenerateFaces});
+  // Zero-area faces with distinct corners alone (a T-junction's filler) are flipped away below once the
+  // surface is known to be closed, and checked after that.
+  const bool zeroAreaOnly =
+      !options.allowDegenerateFaces && out.defects.zeroAreaFaces > 0 && out.defects.repeatedVertexFaces == 0;
+  core::MeshDefects checked = out.defects;
+  if (zeroAreaOnly) checked.zeroAreaFaces = 0;
+  if (Status valid = core::checkDefects(checked, {.allowDegenerateFaces = options.allowDegenerateFaces});
       !valid)
     return withContext(valid.error(), path.string());
   if (options.allowDegenerateFaces) {
@@ -262,6 +268,13 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
       out.verticesWelded = weld.verticesMerged;
       out.facesCollapsedByWeld = weld.facesCollapsed;
     }
+  }
+  if (zeroAreaOnly) {
+    if (out.topology.isClosed() && out.topology.isConsistentlyOriented()) {
+      out.zeroAreaFacesFlipped = core::flipZeroAreaFaces(out.mesh);
+      out.topology = core::analyzeTopology(out.mesh);
+    }
+    if (Status valid = core::validateMesh(out.mesh); !valid) return withContext(valid.error(), path.string());
   }
   if (out.topology.isClosed() && out.topology.isConsistentlyOriented()) {
     out.signedVolumeAsRead = core::computeSignedVolume(out.mesh);
@@ -293,6 +306,12 @@ std::vector<std::string> LoadedMesh::notes() const {
                   (topology.boundaryEdges == 0
                        ? ", which closed the surface"
                        : ", leaving " + std::to_string(topology.boundaryEdges) + " boundary edges"));
+  if (zeroAreaFacesFlipped > 0)
+    out.push_back(
+        std::to_string(zeroAreaFacesFlipped) +
+        (zeroAreaFacesFlipped == 1 ? " zero-area face" : " zero-area faces") +
+        " (corners on one line, where a vertex lies on a neighbour's edge) flipped away: the surface is "
+        "the same, cut into other triangles");
   if (flippedInsideOut) {
     char text[160];
     std::snprintf(text, sizeof text,

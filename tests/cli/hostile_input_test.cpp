@@ -177,6 +177,16 @@ std::vector<Case> corpus() {
       {"tiny_1e-30.obj", [=] { return test::objText(scaled(box, 1e-30)); }, "", nullptr},
       // Faces: zero area, repeated vertices, two corners.
       {"zero_area_face.obj", [] { return kTet + "v 0.5 0 0\n" + kTetFaces + "f 1 5 2\n"; }, "degenerate"},
+      // A T-junction closed by a zero-area face (a unit cube, a vertex on its bottom front edge): flipped
+      // away at load, with a warning, and the cube answered whole.
+      {"t_junction.obj",
+       [] {
+         return std::string(
+             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv 0.5 0 0\n"
+             "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 9 6\nf 1 6 5\nf 9 2 6\nf 1 2 9\nf 2 3 7\n"
+             "f 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+       },
+       "", massNear(1.0)},
       {"repeated_vertex_face.off",
        [] { return "OFF\n4 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 0 0 1\n"; },
        "degenerate"},

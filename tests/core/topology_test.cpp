@@ -162,6 +162,75 @@ TEST(Topology, ShellsAreSignedByTheirWinding) {
   EXPECT_GT(one[0].volume, 4.0);  // a bit under 4π/3 = 4.19
 }
 
+// T-junctions, as CAD tessellations and STL exports leave them: a vertex m put on an edge ab of a closed
+// surface on one side only (the triangle abx split into amx and mbx), and the zero-area face abm that
+// closes the surface again. Flipped away, on random surfaces with random such junctions: no zero-area face
+// is left, the surface is closed and wound as before, its vertices are untouched, and its volume, centroid
+// and second moments are those of the surface before the junctions (the oracle), to round-off.
+TEST(Topology, ZeroAreaFacesOfTJunctionsAreFlippedAwayLeavingTheSameSurface) {
+  std::mt19937_64 rng(31);
+  const auto moments = [](const TriangleMesh& mesh) {
+    // Volume, first and second moments about the origin: sums over tets (0, a, b, c).
+    Eigen::Matrix<double, 10, 1> out = Eigen::Matrix<double, 10, 1>::Zero();
+    for (const auto& t : mesh.triangles) {
+      const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+      const double v = a.dot(b.cross(c)) / 6.0;
+      const Vec3 s = a + b + c;
+      out[0] += v;
+      out.segment<3>(1) += v * s / 4.0;
+      int k = 4;
+      for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+          out[k++] += v / 20.0 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]);
+    }
+    return out;
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    const TriangleMesh original = trial % 2 == 0 ? makeIcosphere(1.0, 2) : makeBox(Vec3(2.0, 1.0, 0.5));
+    TriangleMesh mesh = original;
+    const int junctions = 1 + static_cast<int>(rng() % 6);
+    int made = 0;
+    std::vector<char> used(original.triangles.size(), 0);  // split, or across a split edge
+    for (int tries = 0; made < junctions && tries < 100; ++tries) {
+      const auto t = static_cast<std::uint32_t>(rng() % original.triangles.size());
+      if (used[t]) continue;
+      const int k = static_cast<int>(rng() % 3);
+      const std::uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3],
+                          x = mesh.triangles[t][(k + 2) % 3];
+      std::size_t across = 0;
+      while (across < original.triangles.size() &&
+             !(std::find(original.triangles[across].begin(), original.triangles[across].end(), a) !=
+                   original.triangles[across].end() &&
+               std::find(original.triangles[across].begin(), original.triangles[across].end(), b) !=
+                   original.triangles[across].end() &&
+               across != t))
+        ++across;
+      ASSERT_LT(across, original.triangles.size());
+      if (used[across]) continue;
+      used[t] = used[across] = 1;
+      const double where = std::uniform_real_distribution<double>(0.2, 0.8)(rng);
+      const auto m = static_cast<std::uint32_t>(mesh.vertices.size());
+      mesh.vertices.push_back((1.0 - where) * mesh.vertices[a] + where * mesh.vertices[b]);
+      mesh.triangles[t] = {a, m, x};
+      mesh.triangles.push_back({m, b, x});
+      mesh.triangles.push_back({a, b, m});  // the filler: a → b against the other side's b → a
+      ++made;
+    }
+    ASSERT_GT(made, 0);
+    const TopologyReport before = analyzeTopology(mesh);
+    ASSERT_TRUE(before.isClosed() && before.isConsistentlyOriented());
+    ASSERT_EQ(findDefects(mesh).zeroAreaFaces, static_cast<std::size_t>(made));
+    const std::vector<Vec3> vertices = mesh.vertices;
+    EXPECT_EQ(flipZeroAreaFaces(mesh), static_cast<std::size_t>(made)) << "trial " << trial;
+    EXPECT_EQ(findDefects(mesh).zeroAreaFaces, 0u) << "trial " << trial;
+    const TopologyReport after = analyzeTopology(mesh);
+    EXPECT_TRUE(after.isClosed() && after.isConsistentlyOriented()) << "trial " << trial;
+    EXPECT_EQ(after.eulerCharacteristic(), before.eulerCharacteristic());
+    EXPECT_EQ(mesh.vertices, vertices);
+    EXPECT_LT((moments(mesh) - moments(original)).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
+  }
+}
+
 TEST(Validate, AcceptsAGoodMesh) {
   EXPECT_TRUE(validateMesh(makeIcosphere(1.0, 2)).ok());
 }

@@ -257,6 +257,35 @@ TEST(MeshIo, DegenerateFacesAreAcceptedOnlyWhenAsked) {
   EXPECT_TRUE(loaded.topology.isClosed());
 }
 
+// A closed surface with a T-junction (a vertex on an edge of the unit cube's bottom face, on the front
+// side only, closed by a zero-area face) is read, the face flipped away, and said so; a zero-area face
+// that leaves the surface open (a fin on a tet) is refused as before; asked to keep degenerate faces, the
+// loader keeps it.
+TEST(MeshIo, AZeroAreaFaceOfATJunctionIsFlippedAwayAtLoad) {
+  test::ScratchDir dir("io-tjunction");
+  const std::string cube =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv 0.5 0 0\n"
+      "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 9 6\nf 1 6 5\nf 9 2 6\nf 1 2 9\nf 2 3 7\nf 2 7 6\n"
+      "f 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  test::writeFile(dir / "cube.obj", cube);
+  const LoadedMesh loaded = mustLoad(dir / "cube.obj");
+  EXPECT_EQ(loaded.zeroAreaFacesFlipped, 1u);
+  EXPECT_EQ(loaded.defects.zeroAreaFaces, 1u);  // as read
+  EXPECT_EQ(core::findDefects(loaded.mesh).zeroAreaFaces, 0u);
+  EXPECT_TRUE(loaded.topology.isClosed() && loaded.topology.isConsistentlyOriented());
+  EXPECT_NEAR(volumeOf(loaded.mesh), 1.0, 1e-15);
+  ASSERT_EQ(loaded.notes().size(), 1u);
+  EXPECT_NE(loaded.notes().front().find("1 zero-area face"), std::string::npos) << loaded.notes().front();
+  const LoadedMesh kept = mustLoad(dir / "cube.obj", {.allowDegenerateFaces = true});
+  EXPECT_EQ(kept.zeroAreaFacesFlipped, 0u);
+  EXPECT_EQ(core::findDefects(kept.mesh).zeroAreaFaces, 1u);
+
+  test::writeFile(dir / "fin.obj",
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0.5 0 0\n"
+                  "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 5 2\n");
+  EXPECT_EQ(mustFail(dir / "fin.obj").code, ErrorCode::kDegenerateFace);
+}
+
 TEST(MeshIo, ASurfaceWoundInwardIsFlippedAtLoadAndSaysSo) {
   test::ScratchDir dir("mesh-io-flip");
   const TriangleMesh box = core::makeBox({0.3, 0.2, 0.1});

@@ -90,6 +90,16 @@ Status checkDefects(const MeshDefects& defects, const ValidationOptions& options
 /// "face 7 refers to vertex 120, but the mesh has 100 vertices". Same as checkDefects(findDefects(mesh)).
 Status validateMesh(const TriangleMesh& mesh, const ValidationOptions& options = {});
 
+/// Removes zero-area faces whose corners are distinct and on one line (CAD tessellations and STL exports
+/// leave them where a vertex lies on a neighbour's edge: the filler of a T-junction) by flipping the edge
+/// each lies along: with m its middle corner and x the far corner of the triangle across its long edge
+/// ab, the two become (m, a, x) and (x, b, m). The surface is the same point set, closed and wound as
+/// before; only how it is cut into triangles changes. A face is left as it is where the flip would make a
+/// zero-area face or an edge the surface has already (a fan of such faces along one edge is flipped away
+/// one by one). Returns how many were flipped away. Precondition: closed and consistently oriented
+/// (analyzeTopology), indices in range.
+std::size_t flipZeroAreaFaces(TriangleMesh& mesh);
+
 /// Removes faces with a repeated vertex index (they have no area and no proper edges) and returns how
 /// many were removed. Zero-area faces with distinct vertices stay: they may close a T-junction.
 std::size_t removeRepeatedVertexFaces(TriangleMesh& mesh);

@@ -75,8 +75,11 @@ struct LoadedMesh {
   bool flippedInsideOut = false;         ///< wound inward as read, flipped (LoadOptions::orientOutward)
   std::size_t verticesWelded = 0;        ///< coincident vertices merged (LoadOptions::weld)
   std::size_t facesCollapsedByWeld = 0;  ///< triangles the weld left with a repeated corner, removed
-  double scale = 1.0;                    ///< LoadOptions::scale, applied
-  double signedVolumeAsRead = 0.0;       ///< of a closed, consistent surface as read (m³), else 0
+  /// Zero-area faces of a closed surface flipped away (core::flipZeroAreaFaces), unless
+  /// allowDegenerateFaces keeps them: a surface with any left is refused as before.
+  std::size_t zeroAreaFacesFlipped = 0;
+  double scale = 1.0;               ///< LoadOptions::scale, applied
+  double signedVolumeAsRead = 0.0;  ///< of a closed, consistent surface as read (m³), else 0
 
   /// What a user should hear about the file's mesh ("the surface was wound inward ... flipped"), one
   /// sentence each; empty when it was read as it is.
