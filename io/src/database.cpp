@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <deque>
 #include <functional>
 #include <list>
@@ -415,14 +417,24 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   // A surface of several shells: separate solids, or cavities inside one (only a closed, oriented one
   // says which). The entries the catalog generates are one solid each, without cavities.
   std::size_t solids = 1, cavities = 0;
+  double largestSolidShare = 1.0;  // of the solids' volume
   if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented()) {
     const std::vector<core::Shell> shells = core::findShells(mesh);
     double total = 0.0;
     for (const core::Shell& shell : shells)
       total += shell.volume;
     solids = 0;
-    for (const core::Shell& shell : shells)
-      ++((shell.volume > 0.0) == (total > 0.0) ? solids : cavities);
+    double solidVolume = 0.0, largest = 0.0;
+    for (const core::Shell& shell : shells) {
+      if ((shell.volume > 0.0) != (total > 0.0)) {
+        ++cavities;
+        continue;
+      }
+      ++solids;
+      solidVolume += std::abs(shell.volume);
+      largest = std::max(largest, std::abs(shell.volume));
+    }
+    if (solidVolume > 0.0) largestSolidShare = largest / solidVolume;
   }
   out.times.validate = microsecondsSince(t);
 
@@ -550,12 +562,18 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     const bool generated = out.answeredMatch().entry &&
                            out.answeredMatch().entry->family != volume::Family::kUser &&
                            out.answeredMatch().entry->family != volume::Family::kLearned;
-    if (solids > 1)
-      out.physics->warnings.push_back("the surface is " + std::to_string(solids) +
-                                      " closed shells wound outward (separate solids, or parts that touch or "
-                                      "overlap), not one: the answer "
-                                      "is one body's, as if they were joined, and may be far off; a mesh of "
-                                      "each solid gets its own data");
+    if (solids > 1) {
+      char share[32];
+      std::snprintf(share, sizeof share, "%.3g", 100.0 * largestSolidShare);
+      out.physics->warnings.push_back(
+          "the surface is " + std::to_string(solids) +
+          " closed shells wound outward (separate solids, or parts that touch or overlap), not one; the "
+          "largest "
+          "holds " +
+          share +
+          " % of their volume: the answer is one body's, as if they were joined, and may be "
+          "far off; a mesh of each solid gets its own data");
+    }
     if (cavities > 0 && generated)
       out.physics->warnings.push_back(
           "the surface encloses " + std::to_string(cavities) + (cavities == 1 ? " cavity" : " cavities") +

@@ -944,6 +944,7 @@ TEST(Database, CavitiesAndSeparateSolidsAreSaidAndLearnedObjectsKeepTheirCavitie
     auto two = db->query(apart, options);
     ASSERT_TRUE(two.ok() && two->physics) << (two ? "" : two.error().message);
     EXPECT_TRUE(warned(*two, "2 closed shells wound outward"));
+    EXPECT_TRUE(warned(*two, "the largest holds 50 % of their volume"));
     EXPECT_FALSE(two->predictedFrequencyError.has_value());
   }
   auto ids = addToDatabase(path, std::vector<NamedMesh>{{"hollow.obj", "hollow.obj", hollow}});
