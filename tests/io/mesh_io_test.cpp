@@ -280,6 +280,17 @@ TEST(MeshIo, AZeroAreaFaceOfATJunctionIsFlippedAwayAtLoad) {
   EXPECT_EQ(kept.zeroAreaFacesFlipped, 0u);
   EXPECT_EQ(core::findDefects(kept.mesh).zeroAreaFaces, 1u);
 
+  // Two vertices on the one edge (a fan of two fillers): flipped away in turn.
+  test::writeFile(dir / "fan.obj",
+                  "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv 0.3 0 0\n"
+                  "v 0.6 0 0\nf 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 9 5\nf 9 6 5\nf 9 10 6\nf 10 2 6\n"
+                  "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\nf 1 2 10\nf 1 10 9\n");
+  const LoadedMesh fan = mustLoad(dir / "fan.obj");
+  EXPECT_EQ(fan.zeroAreaFacesFlipped, 2u);
+  EXPECT_EQ(core::findDefects(fan.mesh).zeroAreaFaces, 0u);
+  EXPECT_TRUE(fan.topology.isClosed() && fan.topology.isConsistentlyOriented());
+  EXPECT_NEAR(volumeOf(fan.mesh), 1.0, 1e-15);
+
   test::writeFile(dir / "fin.obj",
                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0.5 0 0\n"
                   "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 5 2\n");
