@@ -163,6 +163,34 @@ TEST(Fracture, OnePieceIsTheWholeSolid) {
   EXPECT_NEAR(volumeOf(r->fragments[0]) / volumeOf(sphere), 1.0, 0.03);
 }
 
+// A hollow ball (an inner shell wound inward, a cavity) breaks into pieces of its wall, not of the ball:
+// the level set is the union of its solids less its cavities. (meshToLevelSet alone signed the cavity
+// inside, and the fragments held twice the solid's volume.) Every fragment is the wall's: none reaches
+// into the cavity.
+TEST(Fracture, AHollowBallBreaksIntoPiecesOfItsWall) {
+  core::TriangleMesh hollow = core::makeIcosphere(1.0, 3);
+  const core::TriangleMesh inner = core::makeIcosphere(0.7, 3);
+  const auto first = static_cast<std::uint32_t>(hollow.vertices.size());
+  for (const core::Vec3& v : inner.vertices)
+    hollow.vertices.push_back(v);
+  for (const auto& t : inner.triangles)
+    hollow.triangles.push_back({t[0] + first, t[2] + first, t[1] + first});
+  FractureOptions options;
+  options.pieces = 6;
+  options.resolution = 48;
+  const Result<FractureResult> r = fracture(hollow, options);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_GE(r->fragments.size(), 2u);
+  double kept = 0.0;
+  for (const core::TriangleMesh& f : r->fragments) {
+    kept += volumeOf(f);
+    for (const core::Vec3& v : f.vertices)
+      ASSERT_GT(v.norm(), 0.7 - 2.0 * r->voxelSize);
+  }
+  EXPECT_NEAR(kept / volumeOf(hollow), 1.0, 0.03);
+  EXPECT_NEAR(r->keptVolume / r->solidVolume, 1.0, 0.03);
+}
+
 TEST(Fracture, FragmentsAreSimplifiedAndTetGenFillsThemExactly) {
   // The raw level-set meshes hold edges a thousandth of a voxel long, on which TetGen failed or merged
   // nearly coplanar facets (moving the surface); simplified fragments mesh, and their tets fill them.

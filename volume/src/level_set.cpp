@@ -7,6 +7,7 @@
 #include <string>
 #include <unordered_map>
 
+#include <openvdb/tools/Composite.h>
 #include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/SignedFloodFill.h>
@@ -62,9 +63,48 @@ OpenVdbMesh toOpenVdb(const TriangleMesh& mesh) {
 }
 
 openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::Transform& transform) {
-  const OpenVdbMesh vdb = toOpenVdb(mesh);
-  return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(transform, vdb.points, vdb.triangles,
-                                                            kLevelSetHalfWidth);
+  const auto one = [&transform](const TriangleMesh& surface) {
+    const OpenVdbMesh vdb = toOpenVdb(surface);
+    return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(transform, vdb.points, vdb.triangles,
+                                                              kLevelSetHalfWidth);
+  };
+  // meshToLevelSet signs a voxel inside where the outside cannot reach it, so it fills a cavity (an inner
+  // shell wound inward: a hollow ball came apart into fragments of twice its volume). A closed surface of
+  // several shells is made of each shell's own solid: the solids joined, the cavities cut out of them.
+  if (!isClosedSolid(mesh)) return one(mesh);
+  const std::vector<core::Shell> shells = core::findShells(mesh);
+  if (shells.size() < 2) return one(mesh);
+  double total = 0.0;
+  for (const core::Shell& shell : shells)
+    total += shell.volume;
+  openvdb::FloatGrid::Ptr solid;
+  std::vector<openvdb::FloatGrid::Ptr> cavities;
+  for (const core::Shell& shell : shells) {
+    const bool cavity = (shell.volume > 0.0) != (total > 0.0);
+    TriangleMesh part;
+    std::unordered_map<std::uint32_t, std::uint32_t> renumbered;
+    for (std::uint32_t t : shell.triangles) {
+      TriangleMesh::Triangle tri = mesh.triangles[t];
+      for (std::uint32_t& v : tri) {
+        const auto [at, added] = renumbered.emplace(v, static_cast<std::uint32_t>(part.vertices.size()));
+        if (added) part.vertices.push_back(mesh.vertices[v]);
+        v = at->second;
+      }
+      if (cavity == (total > 0.0)) std::swap(tri[1], tri[2]);  // wound outward round its own solid
+      part.triangles.push_back(tri);
+    }
+    openvdb::FloatGrid::Ptr grid = one(part);
+    if (cavity)
+      cavities.push_back(std::move(grid));
+    else if (!solid)
+      solid = std::move(grid);
+    else
+      openvdb::tools::csgUnion(*solid, *grid);
+  }
+  if (!solid) return one(mesh);
+  for (const openvdb::FloatGrid::Ptr& cavity : cavities)
+    openvdb::tools::csgDifference(*solid, *cavity);
+  return solid;
 }
 
 bool isClosedSolid(const TriangleMesh& mesh) {

@@ -26,7 +26,8 @@ struct OpenVdbMesh {
 OpenVdbMesh toOpenVdb(const core::TriangleMesh& mesh);
 
 /// The level set of a closed, outward-wound surface in `transform`'s voxels (its points go through
-/// single precision: the caller keeps them near the origin of a local frame).
+/// single precision: the caller keeps them near the origin of a local frame). A surface of several
+/// shells is the union of its solids less its cavities (shells wound inward), each made on its own.
 openvdb::FloatGrid::Ptr levelSet(const core::TriangleMesh& mesh, const openvdb::math::Transform& transform);
 
 /// How a surface came out of its level set.
