@@ -11,6 +11,8 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <shapedb/core/spatial.h>
+#include <shapedb/core/topology.h>
 #include <shapedb/core/weld.h>
 #include <shapedb/io/mesh_io.h>
 
@@ -283,6 +285,34 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
         std::swap(t[1], t[2]);
       out.flippedInsideOut = true;
     }
+    // A shell wound inward is a cavity where the rest of the surface has material around it (winding
+    // number 1 there) and an inside-out solid where it has none (0: apart from every solid, or loose in
+    // another's cavity): such a shell is turned outward as well. A shell wound outward inside another solid
+    // is left as it is (a cavity wound the wrong way, or an insert of another material: no telling).
+    if (options.orientOutward && out.topology.components > 1) {
+      const std::vector<core::Shell> shells = core::findShells(out.mesh);
+      std::size_t inward = 0;
+      for (const core::Shell& shell : shells)
+        inward += shell.volume < 0.0 ? 1 : 0;
+      if (inward <= kMaxShellsChecked) {
+        std::vector<std::uint32_t> turn;
+        for (std::size_t i = 0; i < shells.size(); ++i) {
+          if (!(shells[i].volume < 0.0)) continue;
+          core::TriangleMesh others;
+          others.vertices = out.mesh.vertices;
+          for (std::size_t j = 0; j < shells.size(); ++j)
+            if (j != i)
+              for (std::uint32_t t : shells[j].triangles)
+                others.triangles.push_back(out.mesh.triangles[t]);
+          const core::Vec3& p = out.mesh.vertices[out.mesh.triangles[shells[i].triangles.front()][0]];
+          if (core::windingNumber(others, p) >= 0.5) continue;  // a cavity
+          turn.insert(turn.end(), shells[i].triangles.begin(), shells[i].triangles.end());
+          ++out.shellsTurnedOutward;
+        }
+        for (std::uint32_t t : turn)
+          std::swap(out.mesh.triangles[t][1], out.mesh.triangles[t][2]);
+      }
+    }
   }
   return out;
 }
@@ -312,6 +342,11 @@ std::vector<std::string> LoadedMesh::notes() const {
         (zeroAreaFacesFlipped == 1 ? " zero-area face" : " zero-area faces") +
         " (corners on one line, where a vertex lies on a neighbour's edge) flipped away: the surface is "
         "the same, cut into other triangles");
+  if (shellsTurnedOutward > 0)
+    out.push_back(std::to_string(shellsTurnedOutward) +
+                  (shellsTurnedOutward == 1 ? " closed shell was" : " closed shells were") +
+                  " wound inward with no material around (inside out, not a cavity) and " +
+                  (shellsTurnedOutward == 1 ? "has" : "have") + " been turned outward");
   if (flippedInsideOut) {
     char text[160];
     std::snprintf(text, sizeof text,

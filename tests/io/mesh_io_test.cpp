@@ -297,6 +297,48 @@ TEST(MeshIo, AZeroAreaFaceOfATJunctionIsFlippedAwayAtLoad) {
   EXPECT_EQ(mustFail(dir / "fin.obj").code, ErrorCode::kDegenerateFace);
 }
 
+// Shells of one surface, each oriented by what is around it: a shell wound inward inside a solid is a
+// cavity and stays; one wound inward apart from every solid, or loose in a cavity, is a solid inside
+// out, and is turned outward with a note; the volumes are then the solids' less their cavities.
+TEST(MeshIo, AShellWoundInwardIsACavityOnlyInsideASolid) {
+  test::ScratchDir dir("io-shells");
+  const TriangleMesh ball = core::makeIcosphere(1.0, 2);
+  const auto with = [](TriangleMesh mesh, const TriangleMesh& part, double scale, const Vec3& offset,
+                       bool inward) {
+    const auto first = static_cast<std::uint32_t>(mesh.vertices.size());
+    for (const Vec3& v : part.vertices)
+      mesh.vertices.push_back(scale * v + offset);
+    for (const auto& t : part.triangles)
+      mesh.triangles.push_back(inward ? TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
+                                      : TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
+    return mesh;
+  };
+  const double v = volumeOf(ball);
+  struct Case {
+    std::string name;
+    TriangleMesh mesh;
+    std::size_t turned;
+    double volume;
+  };
+  const TriangleMesh hollow = with(ball, ball, 0.5, Vec3::Zero(), true);
+  const std::vector<Case> cases = {
+      {"hollow", hollow, 0, v * (1.0 - 0.125)},
+      {"apart", with(ball, ball, 0.5, Vec3(3, 0, 0), true), 1, v * 1.125},
+      {"loose", with(hollow, ball, 0.25, Vec3::Zero(), true), 1, v * (1.0 - 0.125 + 0.015625)},
+      {"loose_outward", with(hollow, ball, 0.25, Vec3::Zero(), false), 0, v * (1.0 - 0.125 + 0.015625)},
+  };
+  for (const Case& c : cases) {
+    const auto path = dir / (c.name + ".obj");
+    ASSERT_TRUE(saveMesh(c.mesh, path).ok());
+    const LoadedMesh loaded = mustLoad(path);
+    EXPECT_EQ(loaded.shellsTurnedOutward, c.turned) << c.name;
+    EXPECT_NEAR(volumeOf(loaded.mesh), c.volume, 1e-12 * v) << c.name;
+    EXPECT_EQ(loaded.notes().empty(), c.turned == 0) << c.name;
+    const LoadedMesh asRead = mustLoad(path, {.orientOutward = false});
+    EXPECT_EQ(asRead.shellsTurnedOutward, 0u) << c.name;
+  }
+}
+
 TEST(MeshIo, ASurfaceWoundInwardIsFlippedAtLoadAndSaysSo) {
   test::ScratchDir dir("mesh-io-flip");
   const TriangleMesh box = core::makeBox({0.3, 0.2, 0.1});

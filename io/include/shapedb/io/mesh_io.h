@@ -18,8 +18,9 @@ struct LoadOptions {
   /// zero-area faces with distinct vertices are kept (they contribute nothing to areas or volumes).
   bool allowDegenerateFaces = false;
   /// A closed, consistently oriented surface that encloses a negative volume (wound inward, as some
-  /// exporters write) is flipped, and LoadedMesh::flippedInsideOut says so. An inconsistently oriented
-  /// one is left as it is: no flip can fix it, and the stages that need a solid refuse it.
+  /// exporters write) is flipped, and LoadedMesh::flippedInsideOut says so; so is each of its shells that
+  /// is wound inward with no material around it (LoadedMesh::shellsTurnedOutward). An inconsistently
+  /// oriented one is left as it is: no flip can fix it, and the stages that need a solid refuse it.
   bool orientOutward = true;
   /// Coordinates are multiplied by this as they are read (the file's unit in metres: unitScale("mm") is
   /// 0.001). Positive and finite.
@@ -64,6 +65,10 @@ std::optional<std::uint64_t> availableMemory();
 /// Metres per unit for "mm", "cm", "m", "in" and "ft"; nothing for any other name.
 std::optional<double> unitScale(std::string_view unit);
 
+/// loadMesh tells a cavity from an inside-out solid for surfaces of up to this many shells wound inward
+/// (each is a pass over the rest of the surface: a scan of thousands of specks is read as it is).
+inline constexpr std::size_t kMaxShellsChecked = 64;
+
 /// A mesh read from a file, with what was learnt about it on the way in. Plain value type.
 struct LoadedMesh {
   core::TriangleMesh mesh;
@@ -73,6 +78,9 @@ struct LoadedMesh {
   std::size_t polygonsTriangulated = 0;  ///< faces with more than three vertices, fan-triangulated
   std::size_t facesDropped = 0;          ///< repeated-vertex faces dropped under allowDegenerateFaces
   bool flippedInsideOut = false;         ///< wound inward as read, flipped (LoadOptions::orientOutward)
+  /// Shells wound inward with no material around them (not cavities: inside-out solids of their own),
+  /// turned outward (LoadOptions::orientOutward; surfaces of up to kMaxShellsChecked such shells).
+  std::size_t shellsTurnedOutward = 0;
   std::size_t verticesWelded = 0;        ///< coincident vertices merged (LoadOptions::weld)
   std::size_t facesCollapsedByWeld = 0;  ///< triangles the weld left with a repeated corner, removed
   /// Zero-area faces of a closed surface flipped away (core::flipZeroAreaFaces), unless
