@@ -1,5 +1,6 @@
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -8,6 +9,7 @@
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
 #include <shapedb/core/self_intersection.h>
+#include <shapedb/core/topology.h>
 #include <shapedb/io/mesh_io.h>
 
 #include "commands.h"
@@ -23,9 +25,17 @@ struct InspectOptions {
   MeshInputOptions input;
 };
 
+/// The solids and cavities of a closed, oriented surface's shells; nothing for any other.
+std::optional<core::ShellCount> shellCount(const io::LoadedMesh& loaded) {
+  const core::TopologyReport& t = loaded.topology;
+  if (!t.isClosed() || !t.isConsistentlyOriented()) return std::nullopt;
+  return core::countShells(core::findShells(loaded.mesh));
+}
+
 nlohmann::json topologyJson(const io::LoadedMesh& loaded,
                             const std::vector<core::TriangleCrossing>& crossings) {
   const core::TopologyReport& t = loaded.topology;
+  const std::optional<core::ShellCount> shells = shellCount(loaded);
   nlohmann::json firstCrossing = nullptr;
   if (!crossings.empty())
     firstCrossing = {{"triangles", {crossings.front().first, crossings.front().second}},
@@ -38,6 +48,8 @@ nlohmann::json topologyJson(const io::LoadedMesh& loaded,
           {"non_manifold_edges", t.nonManifoldEdges},
           {"inconsistent_edges", t.inconsistentEdges},
           {"components", t.components},
+          {"solids", shells ? nlohmann::json(shells->solids) : nlohmann::json(nullptr)},
+          {"cavities", shells ? nlohmann::json(shells->cavities) : nlohmann::json(nullptr)},
           {"euler_characteristic", t.eulerCharacteristic()},
           {"is_closed", t.isClosed()},
           {"is_consistently_oriented", t.isConsistentlyOriented()},
@@ -90,6 +102,10 @@ void printText(const InspectOptions& options, const io::LoadedMesh& loaded,
               t.isClosed() ? "closed" : "OPEN",
               t.isConsistentlyOriented() ? "consistently oriented" : "INCONSISTENT", t.components,
               t.components == 1 ? "" : "s", t.eulerCharacteristic());
+  if (const std::optional<core::ShellCount> shells = shellCount(loaded); shells && t.components > 1)
+    std::printf("  shells: %zu solid%s, %zu cavit%s (inner shells wound inward: hollow there)\n",
+                shells->solids, shells->solids == 1 ? "" : "s", shells->cavities,
+                shells->cavities == 1 ? "y" : "ies");
   std::printf("  boundary edges %zu, non-manifold edges %zu, inconsistent edges %zu, zero-area faces %zu\n",
               t.boundaryEdges, t.nonManifoldEdges, t.inconsistentEdges, loaded.defects.zeroAreaFaces);
   if (crossings.empty()) {

@@ -241,6 +241,25 @@ std::vector<Shell> findShells(const TriangleMesh& mesh) {
   return shells;
 }
 
+ShellCount countShells(const std::vector<Shell>& shells) {
+  double total = 0.0;
+  for (const Shell& shell : shells)
+    total += shell.volume;
+  ShellCount out;
+  double solidVolume = 0.0, largest = 0.0;
+  for (const Shell& shell : shells) {
+    if ((shell.volume > 0.0) != (total > 0.0)) {
+      ++out.cavities;
+      continue;
+    }
+    ++out.solids;
+    solidVolume += std::abs(shell.volume);
+    largest = std::max(largest, std::abs(shell.volume));
+  }
+  if (solidVolume > 0.0) out.largestSolidShare = largest / solidVolume;
+  return out;
+}
+
 MeshDefects findDefects(const TriangleMesh& mesh) {
   MeshDefects d;
   d.vertexCount = mesh.vertices.size();

@@ -416,26 +416,11 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   const core::TopologyReport topology = core::analyzeTopology(mesh);
   // A surface of several shells: separate solids, or cavities inside one (only a closed, oriented one
   // says which). The entries the catalog generates are one solid each, without cavities.
-  std::size_t solids = 1, cavities = 0;
-  double largestSolidShare = 1.0;  // of the solids' volume
-  if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented()) {
-    const std::vector<core::Shell> shells = core::findShells(mesh);
-    double total = 0.0;
-    for (const core::Shell& shell : shells)
-      total += shell.volume;
-    solids = 0;
-    double solidVolume = 0.0, largest = 0.0;
-    for (const core::Shell& shell : shells) {
-      if ((shell.volume > 0.0) != (total > 0.0)) {
-        ++cavities;
-        continue;
-      }
-      ++solids;
-      solidVolume += std::abs(shell.volume);
-      largest = std::max(largest, std::abs(shell.volume));
-    }
-    if (solidVolume > 0.0) largestSolidShare = largest / solidVolume;
-  }
+  core::ShellCount shells{.solids = 1};
+  if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented())
+    shells = core::countShells(core::findShells(mesh));
+  const std::size_t solids = shells.solids, cavities = shells.cavities;
+  const double largestSolidShare = shells.largestSolidShare;
   out.times.validate = microsecondsSince(t);
 
   t = Clock::now();

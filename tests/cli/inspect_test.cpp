@@ -1,3 +1,5 @@
+#include <tuple>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -96,6 +98,33 @@ TEST(CliInspect, CountsTheTrianglesThatCross) {
   const nlohmann::json boxTopology = nlohmann::json::parse(box.out)["topology"];
   EXPECT_EQ(boxTopology["crossing_triangle_pairs"].get<int>(), 0);
   EXPECT_TRUE(boxTopology["first_crossing"].is_null());
+}
+
+// A surface of several shells: its solids and cavities counted, in the text and the JSON (a box with a
+// box-shaped cavity; two boxes apart; one box).
+TEST(CliInspect, CountsTheSolidsAndCavitiesOfItsShells) {
+  test::ScratchDir dir("cli-shells");
+  core::TriangleMesh hollow = core::makeBox({2, 2, 2});
+  const core::TriangleMesh inner = core::makeBox({1, 1, 1});
+  const auto first = static_cast<std::uint32_t>(hollow.vertices.size());
+  hollow.vertices.insert(hollow.vertices.end(), inner.vertices.begin(), inner.vertices.end());
+  for (const auto& t : inner.triangles)
+    hollow.triangles.push_back({t[0] + first, t[2] + first, t[1] + first});
+  ASSERT_TRUE(io::saveMesh(hollow, dir / "hollow.obj").ok());
+  ASSERT_TRUE(io::saveMesh(test::twoUnitBoxes({3.0, 0.0, 0.0}), dir / "apart.obj").ok());
+  ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), dir / "box.obj").ok());
+  for (const auto& [name, solids, cavities] :
+       {std::tuple{"hollow.obj", 1, 1}, {"apart.obj", 2, 0}, {"box.obj", 1, 0}}) {
+    const test::ProcessResult json = shapedb({"inspect", (dir / name).string(), "--json"});
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    const nlohmann::json topology = nlohmann::json::parse(json.out)["topology"];
+    EXPECT_EQ(topology["solids"].get<int>(), solids) << name;
+    EXPECT_EQ(topology["cavities"].get<int>(), cavities) << name;
+  }
+  const test::ProcessResult text = shapedb({"inspect", (dir / "hollow.obj").string()});
+  EXPECT_NE(text.out.find("shells: 1 solid, 1 cavity"), std::string::npos) << text.out;
+  const test::ProcessResult one = shapedb({"inspect", (dir / "box.obj").string()});
+  EXPECT_EQ(one.out.find("shells:"), std::string::npos) << one.out;
 }
 
 TEST(CliInspect, OpenMeshFailsWithOneLineUnlessApproximate) {

@@ -147,6 +147,10 @@ TEST(Topology, ShellsAreSignedByTheirWinding) {
     EXPECT_NEAR(shells[1].volume, -0.5, 1e-9);
     EXPECT_EQ(shells[0].triangles.size(), 12u);
     EXPECT_EQ(shells[1].triangles.front(), 12u);
+    const ShellCount hollowCount = countShells(shells);
+    EXPECT_EQ(hollowCount.solids, 1u);
+    EXPECT_EQ(hollowCount.cavities, 1u);
+    EXPECT_DOUBLE_EQ(hollowCount.largestSolidShare, 1.0);
 
     TriangleMesh apart;
     append(apart, makeBox(Vec3(1, 1, 1)), far, false);
@@ -155,6 +159,10 @@ TEST(Topology, ShellsAreSignedByTheirWinding) {
     ASSERT_EQ(two.size(), 2u);
     EXPECT_NEAR(two[0].volume, 1.0, 1e-9);
     EXPECT_NEAR(two[1].volume, 2.0, 1e-9);
+    const ShellCount twoCount = countShells(two);
+    EXPECT_EQ(twoCount.solids, 2u);
+    EXPECT_EQ(twoCount.cavities, 0u);
+    EXPECT_NEAR(twoCount.largestSolidShare, 2.0 / 3.0, 1e-12);
   }
   const std::vector<Shell> one = findShells(makeIcosphere(1.0, 2));
   ASSERT_EQ(one.size(), 1u);

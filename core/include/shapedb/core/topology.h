@@ -56,6 +56,15 @@ struct Shell {
 /// (validateMesh); the volumes mean what they say only for a closed, consistently oriented surface.
 std::vector<Shell> findShells(const TriangleMesh& mesh);
 
+/// What shells bound: a shell wound as the whole surface is (the sign of their volumes' sum) bounds a
+/// solid, one wound against it a cavity of the solid around it.
+struct ShellCount {
+  std::size_t solids = 0;
+  std::size_t cavities = 0;
+  double largestSolidShare = 1.0;  ///< the largest solid's share of the solids' volume
+};
+ShellCount countShells(const std::vector<Shell>& shells);
+
 /// What validateMesh tolerates.
 struct ValidationOptions {
   /// Keep going past degenerate faces (repeated vertex or zero area); they are still counted.
