@@ -238,17 +238,19 @@ std::vector<Shell> findShells(const TriangleMesh& mesh) {
     shells[shell].triangles.push_back(static_cast<std::uint32_t>(f));
     shells[shell].volume += a.dot(b.cross(c)) / 6.0;
   }
+  double total = 0.0;
+  for (const Shell& shell : shells)
+    total += shell.volume;
+  for (Shell& shell : shells)
+    shell.cavity = (shell.volume > 0.0) != (total > 0.0);
   return shells;
 }
 
 ShellCount countShells(const std::vector<Shell>& shells) {
-  double total = 0.0;
-  for (const Shell& shell : shells)
-    total += shell.volume;
   ShellCount out;
   double solidVolume = 0.0, largest = 0.0;
   for (const Shell& shell : shells) {
-    if ((shell.volume > 0.0) != (total > 0.0)) {
+    if (shell.cavity) {
       ++out.cavities;
       continue;
     }

@@ -390,6 +390,17 @@ Result<std::vector<core::Match>> Database::match(const core::TriangleMesh& mesh,
   return matches;
 }
 
+namespace {
+
+/// Whether a match's entry is one the catalog generated (a single solid without cavities), not a user's or
+/// a learned one.
+bool generatedEntry(const MatchReport& match) {
+  return match.entry && match.entry->family != volume::Family::kUser &&
+         match.entry->family != volume::Family::kLearned;
+}
+
+}  // namespace
+
 Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryOptions& options) const {
   const Clock::time_point start = Clock::now();
   QueryResult out;
@@ -419,8 +430,6 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   core::ShellCount shells{.solids = 1};
   if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented())
     shells = core::countShells(core::findShells(mesh));
-  const std::size_t solids = shells.solids, cavities = shells.cavities;
-  const double largestSolidShare = shells.largestSolidShare;
   out.times.validate = microsecondsSince(t);
 
   t = Clock::now();
@@ -544,24 +553,21 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     out.physics = std::move(adapted).value();
     out.physics->warnings.insert(out.physics->warnings.end(), correctionWarnings.begin(),
                                  correctionWarnings.end());
-    const bool generated = out.answeredMatch().entry &&
-                           out.answeredMatch().entry->family != volume::Family::kUser &&
-                           out.answeredMatch().entry->family != volume::Family::kLearned;
-    if (solids > 1) {
+    const bool generated = generatedEntry(out.answeredMatch());
+    if (shells.solids > 1) {
       char share[32];
-      std::snprintf(share, sizeof share, "%.3g", 100.0 * largestSolidShare);
-      out.physics->warnings.push_back(
-          "the surface is " + std::to_string(solids) +
-          " closed shells wound outward (separate solids, or parts that touch or overlap), not one; the "
-          "largest "
-          "holds " +
-          share +
-          " % of their volume: the answer is one body's, as if they were joined, and may be "
-          "far off; a mesh of each solid gets its own data");
+      std::snprintf(share, sizeof share, "%.3g", 100.0 * shells.largestSolidShare);
+      out.physics->warnings.push_back("the surface is " + std::to_string(shells.solids) +
+                                      " closed shells wound outward (separate solids, or parts that touch or "
+                                      "overlap), not one; the largest holds " +
+                                      share +
+                                      " % of their volume: the answer is one body's, as if they were joined, "
+                                      "and may be far off; a mesh of each solid gets its own data");
     }
-    if (cavities > 0 && generated)
+    if (shells.cavities > 0 && generated)
       out.physics->warnings.push_back(
-          "the surface encloses " + std::to_string(cavities) + (cavities == 1 ? " cavity" : " cavities") +
+          "the surface encloses " + std::to_string(shells.cavities) +
+          (shells.cavities == 1 ? " cavity" : " cavities") +
           " (a closed shell wound inward: the solid is hollow there), which the catalog's entries do not "
           "have: the answer is of a body without them and may be far off; the object's own data, computed "
           "with them, come from enrichment");
@@ -600,10 +606,7 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
       }
       // The model was fitted on single solids without cavities: outside them it has nothing to say (and an
       // unknown error is one enrichment learns from).
-      const bool generated = out.answeredMatch().entry &&
-                             out.answeredMatch().entry->family != volume::Family::kUser &&
-                             out.answeredMatch().entry->family != volume::Family::kLearned;
-      if (solids == 1 && (cavities == 0 || !generated))
+      if (shells.solids == 1 && (shells.cavities == 0 || !generatedEntry(out.answeredMatch())))
         out.predictedFrequencyError = core::predictFrequencyError(evidence);
     }
   }

@@ -291,13 +291,10 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
     // is left as it is (a cavity wound the wrong way, or an insert of another material: no telling).
     if (options.orientOutward && out.topology.components > 1) {
       const std::vector<core::Shell> shells = core::findShells(out.mesh);
-      std::size_t inward = 0;
-      for (const core::Shell& shell : shells)
-        inward += shell.volume < 0.0 ? 1 : 0;
-      if (inward <= kMaxShellsChecked) {
+      if (core::countShells(shells).cavities <= kMaxShellsChecked) {
         std::vector<std::uint32_t> turn;
         for (std::size_t i = 0; i < shells.size(); ++i) {
-          if (!(shells[i].volume < 0.0)) continue;
+          if (!shells[i].cavity) continue;  // wound inward: the surface is outward now
           core::TriangleMesh others;
           others.vertices = out.mesh.vertices;
           for (std::size_t j = 0; j < shells.size(); ++j)

@@ -74,13 +74,9 @@ openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::
   if (!isClosedSolid(mesh)) return one(mesh);
   const std::vector<core::Shell> shells = core::findShells(mesh);
   if (shells.size() < 2) return one(mesh);
-  double total = 0.0;
-  for (const core::Shell& shell : shells)
-    total += shell.volume;
   openvdb::FloatGrid::Ptr solid;
   std::vector<openvdb::FloatGrid::Ptr> cavities;
   for (const core::Shell& shell : shells) {
-    const bool cavity = (shell.volume > 0.0) != (total > 0.0);
     TriangleMesh part;
     std::unordered_map<std::uint32_t, std::uint32_t> renumbered;
     for (std::uint32_t t : shell.triangles) {
@@ -90,11 +86,11 @@ openvdb::FloatGrid::Ptr levelSet(const TriangleMesh& mesh, const openvdb::math::
         if (added) part.vertices.push_back(mesh.vertices[v]);
         v = at->second;
       }
-      if (cavity == (total > 0.0)) std::swap(tri[1], tri[2]);  // wound outward round its own solid
+      if (shell.volume < 0.0) std::swap(tri[1], tri[2]);  // wound outward round its own solid
       part.triangles.push_back(tri);
     }
     openvdb::FloatGrid::Ptr grid = one(part);
-    if (cavity)
+    if (shell.cavity)
       cavities.push_back(std::move(grid));
     else if (!solid)
       solid = std::move(grid);

@@ -91,8 +91,8 @@ Status fillsSurface(const TetMesh& mesh, const core::MassProperties& mass) {
   return Ok{};
 }
 
-/// The surface's closed shells sorted by what they bound, for a surface wound outward: the solids (shells
-/// wound as the whole surface is) and the cavities (the others: voids inside a solid).
+/// The surface's closed shells sorted by what they bound (core::Shell::cavity): the solids, and a point in
+/// each cavity.
 struct Shells {
   std::size_t solids = 0;
   /// A point inside each cavity, for TetGen's hole list: TetGen fills a cavity with tets as it fills the
@@ -102,19 +102,13 @@ struct Shells {
   std::vector<core::Vec3> holes;
 };
 
-Result<Shells> findShells(const TriangleMesh& surface, double volume) {
+Result<Shells> shellsToMesh(const TriangleMesh& surface) {
   Shells out;
   const std::vector<core::Shell> shells = core::findShells(surface);
-  if (shells.size() == 1) {
-    out.solids = 1;
-    return out;
-  }
+  out.solids = core::countShells(shells).solids;
   std::optional<core::ClosestPointTree> tree;
   for (const core::Shell& shell : shells) {
-    if ((shell.volume > 0.0) == (volume > 0.0)) {
-      ++out.solids;
-      continue;
-    }
+    if (!shell.cavity) continue;
     std::uint32_t largest = shell.triangles.front();
     double largestArea = -1.0;
     core::Vec3 normal = core::Vec3::Zero();
@@ -132,8 +126,8 @@ Result<Shells> findShells(const TriangleMesh& surface, double volume) {
     const core::Vec3 centroid =
         (surface.vertices[tri[0]] + surface.vertices[tri[1]] + surface.vertices[tri[2]]) / 3.0;
     if (!tree) tree.emplace(surface);
-    // Wound against the surface: its normal points into the void when the surface's points out of the solid.
-    const core::Vec3 into = (volume > 0.0 ? 1.0 : -1.0) * normal.normalized();
+    // Its normal points into the void where it is wound inward (negative volume: the surface outward).
+    const core::Vec3 into = (shell.volume < 0.0 ? 1.0 : -1.0) * normal.normalized();
     const std::optional<core::RayHit> hit = tree->firstHit(centroid, into, 0.0, largest);
     if (!(largestArea > 0.0) || !hit || !(hit->distance > 0.0))
       return Error{ErrorCode::kParse, "a cavity of the solid (a closed shell wound inward, " +
@@ -206,7 +200,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   // Per triangle: the same for every run below, the turned surface's included (its triangles are these,
   // and its volume bounds the same).
   const std::vector<double> wallBounds = wallVolumeBounds(surface, options, mass->volume);
-  auto shells = findShells(surface, mass->volume);
+  auto shells = shellsToMesh(surface);
   if (!shells) return shells.error();
 
   // TetGen merges adjacent facets it finds nearly coplanar, which moves a surface whose facets are only

@@ -50,14 +50,17 @@ Status requireClosedOriented(const TopologyReport& topology);
 struct Shell {
   std::vector<std::uint32_t> triangles;  ///< indices into the mesh's triangles, ascending
   double volume = 0.0;                   ///< signed, in the mesh's units cubed
+  /// Wound against the whole surface (the sign of all its shells' volumes summed): a cavity of the solid
+  /// around it; else it bounds a solid.
+  bool cavity = false;
 };
 
 /// The shells of `mesh`, in the order of their first triangle. Precondition: indices in range
-/// (validateMesh); the volumes mean what they say only for a closed, consistently oriented surface.
+/// (validateMesh); the volumes and roles mean what they say only for a closed, consistently oriented
+/// surface.
 std::vector<Shell> findShells(const TriangleMesh& mesh);
 
-/// What shells bound: a shell wound as the whole surface is (the sign of their volumes' sum) bounds a
-/// solid, one wound against it a cavity of the solid around it.
+/// How many solids and cavities shells bound (Shell::cavity).
 struct ShellCount {
   std::size_t solids = 0;
   std::size_t cavities = 0;
