@@ -104,12 +104,8 @@ TEST(CliInspect, CountsTheTrianglesThatCross) {
 // box-shaped cavity; two boxes apart; one box).
 TEST(CliInspect, CountsTheSolidsAndCavitiesOfItsShells) {
   test::ScratchDir dir("cli-shells");
-  core::TriangleMesh hollow = core::makeBox({2, 2, 2});
-  const core::TriangleMesh inner = core::makeBox({1, 1, 1});
-  const auto first = static_cast<std::uint32_t>(hollow.vertices.size());
-  hollow.vertices.insert(hollow.vertices.end(), inner.vertices.begin(), inner.vertices.end());
-  for (const auto& t : inner.triangles)
-    hollow.triangles.push_back({t[0] + first, t[2] + first, t[1] + first});
+  const core::TriangleMesh hollow =
+      test::withShell(core::makeBox({2, 2, 2}), core::makeBox({1, 1, 1}), core::Vec3::Zero(), true);
   ASSERT_TRUE(io::saveMesh(hollow, dir / "hollow.obj").ok());
   ASSERT_TRUE(io::saveMesh(test::twoUnitBoxes({3.0, 0.0, 0.0}), dir / "apart.obj").ok());
   ASSERT_TRUE(io::saveMesh(core::makeBox({1, 2, 3}), dir / "box.obj").ok());

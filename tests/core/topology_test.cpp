@@ -9,6 +9,8 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/core/topology.h>
 
+#include "support/test_support.h"
+
 namespace shapedb::core {
 namespace {
 
@@ -129,18 +131,9 @@ TEST(Topology, BucketedAnalysisAgreesWithTheGlobalSortOnRandomMeshes) {
 // inward) is a solid shell and a cavity whose volumes sum to the solid's; two boxes apart are two solids;
 // far from the origin the volumes are as exact (each is summed about a vertex of its own).
 TEST(Topology, ShellsAreSignedByTheirWinding) {
-  const auto append = [](TriangleMesh& to, const TriangleMesh& from, const Vec3& offset, bool inward) {
-    const auto first = static_cast<std::uint32_t>(to.vertices.size());
-    for (const Vec3& v : from.vertices)
-      to.vertices.push_back(v + offset);
-    for (const auto& t : from.triangles)
-      to.triangles.push_back(inward ? TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
-                                    : TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
-  };
   for (const Vec3& far : {Vec3(0, 0, 0), Vec3(1e6, -2e6, 3e5)}) {
-    TriangleMesh hollow;
-    append(hollow, makeBox(Vec3(2, 2, 2)), far, false);
-    append(hollow, makeBox(Vec3(1, 1, 0.5)), far + Vec3(0.2, 0.1, 0.0), true);
+    const TriangleMesh hollow = test::withShell(test::withShell({}, makeBox(Vec3(2, 2, 2)), far, false),
+                                                makeBox(Vec3(1, 1, 0.5)), far + Vec3(0.2, 0.1, 0.0), true);
     const std::vector<Shell> shells = findShells(hollow);
     ASSERT_EQ(shells.size(), 2u);
     EXPECT_NEAR(shells[0].volume, 8.0, 1e-9);
@@ -152,9 +145,8 @@ TEST(Topology, ShellsAreSignedByTheirWinding) {
     EXPECT_EQ(hollowCount.cavities, 1u);
     EXPECT_DOUBLE_EQ(hollowCount.largestSolidShare, 1.0);
 
-    TriangleMesh apart;
-    append(apart, makeBox(Vec3(1, 1, 1)), far, false);
-    append(apart, makeBox(Vec3(1, 2, 1)), far + Vec3(3, 0, 0), false);
+    const TriangleMesh apart = test::withShell(test::withShell({}, makeBox(Vec3(1, 1, 1)), far, false),
+                                               makeBox(Vec3(1, 2, 1)), far + Vec3(3, 0, 0), false);
     const std::vector<Shell> two = findShells(apart);
     ASSERT_EQ(two.size(), 2u);
     EXPECT_NEAR(two[0].volume, 1.0, 1e-9);

@@ -908,21 +908,10 @@ TEST(Database, CavitiesAndSeparateSolidsAreSaidAndLearnedObjectsKeepTheirCavitie
   test::ScratchDir dir("database-shells");
   const auto path = dir / "a.db";
   ASSERT_TRUE(buildDatabase(path, smallBuild(2, {volume::Family::kBox}, 2)).ok());
-  const auto shellOf = [](core::TriangleMesh outer, const core::TriangleMesh& inner, const core::Vec3& offset,
-                          bool cavity) {
-    const auto first = static_cast<std::uint32_t>(outer.vertices.size());
-    for (const core::Vec3& v : inner.vertices)
-      outer.vertices.push_back(v + offset);
-    for (const auto& t : inner.triangles)
-      outer.triangles.push_back(cavity
-                                    ? core::TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
-                                    : core::TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
-    return outer;
-  };
   const core::TriangleMesh box = core::makeBox(core::Vec3(1.0, 0.8, 0.6));
   const core::TriangleMesh hollow =
-      shellOf(box, core::makeBox(core::Vec3(0.7, 0.5, 0.3)), core::Vec3::Zero(), true);
-  const core::TriangleMesh apart = shellOf(box, box, core::Vec3(2.0, 0.0, 0.0), false);
+      test::withShell(box, core::makeBox(core::Vec3(0.7, 0.5, 0.3)), core::Vec3::Zero(), true);
+  const core::TriangleMesh apart = test::withShell(box, box, core::Vec3(2.0, 0.0, 0.0), false);
   QueryOptions options;
   options.fidelity = true;
   options.link = true;

@@ -303,16 +303,6 @@ TEST(MeshIo, AZeroAreaFaceOfATJunctionIsFlippedAwayAtLoad) {
 TEST(MeshIo, AShellWoundInwardIsACavityOnlyInsideASolid) {
   test::ScratchDir dir("io-shells");
   const TriangleMesh ball = core::makeIcosphere(1.0, 2);
-  const auto with = [](TriangleMesh mesh, const TriangleMesh& part, double scale, const Vec3& offset,
-                       bool inward) {
-    const auto first = static_cast<std::uint32_t>(mesh.vertices.size());
-    for (const Vec3& v : part.vertices)
-      mesh.vertices.push_back(scale * v + offset);
-    for (const auto& t : part.triangles)
-      mesh.triangles.push_back(inward ? TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
-                                      : TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
-    return mesh;
-  };
   const double v = volumeOf(ball);
   struct Case {
     std::string name;
@@ -320,12 +310,13 @@ TEST(MeshIo, AShellWoundInwardIsACavityOnlyInsideASolid) {
     std::size_t turned;
     double volume;
   };
-  const TriangleMesh hollow = with(ball, ball, 0.5, Vec3::Zero(), true);
+  const TriangleMesh hollow = test::withShell(ball, ball, Vec3::Zero(), true, 0.5);
   const std::vector<Case> cases = {
       {"hollow", hollow, 0, v * (1.0 - 0.125)},
-      {"apart", with(ball, ball, 0.5, Vec3(3, 0, 0), true), 1, v * 1.125},
-      {"loose", with(hollow, ball, 0.25, Vec3::Zero(), true), 1, v * (1.0 - 0.125 + 0.015625)},
-      {"loose_outward", with(hollow, ball, 0.25, Vec3::Zero(), false), 0, v * (1.0 - 0.125 + 0.015625)},
+      {"apart", test::withShell(ball, ball, Vec3(3, 0, 0), true, 0.5), 1, v * 1.125},
+      {"loose", test::withShell(hollow, ball, Vec3::Zero(), true, 0.25), 1, v * (1.0 - 0.125 + 0.015625)},
+      {"loose_outward", test::withShell(hollow, ball, Vec3::Zero(), false, 0.25), 0,
+       v * (1.0 - 0.125 + 0.015625)},
   };
   for (const Case& c : cases) {
     const auto path = dir / (c.name + ".obj");

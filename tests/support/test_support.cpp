@@ -75,15 +75,17 @@ std::string readFile(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+core::TriangleMesh withShell(core::TriangleMesh outer, const core::TriangleMesh& inner,
+                             const core::Vec3& offset, bool cavity, double scale) {
+  core::TriangleMesh shell = cavity ? core::flipped(inner) : inner;
+  for (core::Vec3& v : shell.vertices)
+    v = scale * v + offset;
+  core::append(outer, shell);
+  return outer;
+}
+
 core::TriangleMesh twoUnitBoxes(const core::Vec3& offset) {
-  core::TriangleMesh both = core::makeBox({1, 1, 1});
-  const core::TriangleMesh other = core::makeBox({1, 1, 1});
-  const auto first = static_cast<std::uint32_t>(both.vertices.size());
-  for (const core::Vec3& v : other.vertices)
-    both.vertices.push_back(v + offset);
-  for (const auto& t : other.triangles)
-    both.triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
-  return both;
+  return withShell(core::makeBox({1, 1, 1}), core::makeBox({1, 1, 1}), offset, false);
 }
 
 core::TetMesh makeTetGrid(int nx, int ny, int nz, double jitter, std::mt19937_64& rng) {

@@ -53,6 +53,12 @@ std::optional<std::filesystem::path> realMeshDirectory(std::string* why = nullpt
 /// interior nodes jittered by up to `jitter`: a conforming tet mesh with irregular tets.
 core::TetMesh makeTetGrid(int nx, int ny, int nz, double jitter, std::mt19937_64& rng);
 
+/// `outer` with `inner` added as one more shell, scaled by `scale` and moved by `offset` (its vertices and
+/// triangles after outer's): wound inward when `cavity` (a void in the solid around it), else as given (a
+/// solid of its own).
+core::TriangleMesh withShell(core::TriangleMesh outer, const core::TriangleMesh& inner,
+                             const core::Vec3& offset, bool cavity, double scale = 1.0);
+
 /// Two unit cubes written as one mesh, the second moved by `offset` (its 8 vertices and 12 triangles
 /// after the first's), as an export of two parts is: overlapping, the surface passes through itself;
 /// apart, it bounds two solids.

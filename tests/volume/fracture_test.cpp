@@ -10,6 +10,8 @@
 #include <shapedb/volume/fracture.h>
 #include <shapedb/volume/tetrahedralize.h>
 
+#include "support/test_support.h"
+
 namespace shapedb::volume {
 namespace {
 
@@ -168,13 +170,8 @@ TEST(Fracture, OnePieceIsTheWholeSolid) {
 // inside, and the fragments held twice the solid's volume.) Every fragment is the wall's: none reaches
 // into the cavity.
 TEST(Fracture, AHollowBallBreaksIntoPiecesOfItsWall) {
-  core::TriangleMesh hollow = core::makeIcosphere(1.0, 3);
-  const core::TriangleMesh inner = core::makeIcosphere(0.7, 3);
-  const auto first = static_cast<std::uint32_t>(hollow.vertices.size());
-  for (const core::Vec3& v : inner.vertices)
-    hollow.vertices.push_back(v);
-  for (const auto& t : inner.triangles)
-    hollow.triangles.push_back({t[0] + first, t[2] + first, t[1] + first});
+  const core::TriangleMesh hollow =
+      test::withShell(core::makeIcosphere(1.0, 3), core::makeIcosphere(0.7, 3), core::Vec3::Zero(), true);
   FractureOptions options;
   options.pieces = 6;
   options.resolution = 48;

@@ -366,13 +366,7 @@ TEST(Modal, FreeFreeBeamAtTheDefaultQuadraticMeshingMatchesEulerBernoulli) {
 // as TetGen fills a cavity it is not told of, the two would ring alike.
 TEST(Modal, AHollowBallRingsBelowTheSolidOne) {
   const core::TriangleMesh solid = core::makeIcosphere(1.0, 3);
-  core::TriangleMesh hollow = solid;
-  const core::TriangleMesh inner = core::makeIcosphere(0.8, 3);
-  const auto first = static_cast<std::uint32_t>(hollow.vertices.size());
-  for (const Vec3& v : inner.vertices)
-    hollow.vertices.push_back(v);
-  for (const auto& t : inner.triangles)  // wound inward: a cavity
-    hollow.triangles.push_back({t[0] + first, t[2] + first, t[1] + first});
+  const core::TriangleMesh hollow = test::withShell(solid, core::makeIcosphere(0.8, 3), Vec3::Zero(), true);
   const ModalOptions options{.modes = 3, .material = core::unitMaterial(0.3)};
   const TetMesh solidTets = tetsOrDie(solid, {.maxVolumeFraction = 1.0 / 300.0});
   const TetMesh hollowTets = tetsOrDie(hollow, {.maxVolumeFraction = 1.0 / 300.0});

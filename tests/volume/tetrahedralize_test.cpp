@@ -19,6 +19,8 @@
 #include <shapedb/volume/modal.h>
 #include <shapedb/volume/tetrahedralize.h>
 
+#include "support/test_support.h"
+
 namespace shapedb::volume {
 namespace {
 
@@ -157,28 +159,15 @@ TEST(Tetrahedralize, GuardedAndInProcessGiveTheSameMesh) {
     ASSERT_EQ(guarded.nodes[i], local.nodes[i]);
 }
 
-/// `inner` appended to `outer`, moved by `offset` and wound inward when `cavity` (a void in the solid).
-core::TriangleMesh withShell(core::TriangleMesh outer, const core::TriangleMesh& inner, const Vec3& offset,
-                             bool cavity) {
-  const auto first = static_cast<std::uint32_t>(outer.vertices.size());
-  for (const Vec3& v : inner.vertices)
-    outer.vertices.push_back(v + offset);
-  for (const auto& t : inner.triangles)
-    outer.triangles.push_back(cavity
-                                  ? core::TriangleMesh::Triangle{t[0] + first, t[2] + first, t[1] + first}
-                                  : core::TriangleMesh::Triangle{t[0] + first, t[1] + first, t[2] + first});
-  return outer;
-}
-
 // A solid with cavities (inner shells wound inward: a hollow casting, a sealed tank modelled with both
 // sides of its wall): TetGen fills a cavity as it fills the solid unless told where it is, and the fill
 // check then refused the mesh. The cavities are left empty now: the tets hold the solid's volume and
 // none lies in a cavity, guarded or not (the hole points cross to the worker).
 TEST(Tetrahedralize, ACavityIsLeftEmpty) {
-  core::TriangleMesh hollow =
-      withShell(core::makeBox(Vec3(2, 1.5, 1)), core::makeBox(Vec3(1, 0.8, 0.5)), Vec3(0.3, 0.1, 0.0), true);
-  hollow = withShell(std::move(hollow), core::makeUvEllipsoid(Vec3(0.15, 0.15, 0.15), 12, 6),
-                     Vec3(-0.6, 0.0, 0.0), true);
+  core::TriangleMesh hollow = test::withShell(core::makeBox(Vec3(2, 1.5, 1)),
+                                              core::makeBox(Vec3(1, 0.8, 0.5)), Vec3(0.3, 0.1, 0.0), true);
+  hollow = test::withShell(std::move(hollow), core::makeUvEllipsoid(Vec3(0.15, 0.15, 0.15), 12, 6),
+                           Vec3(-0.6, 0.0, 0.0), true);
   const double solid =
       3.0 - 0.4 - core::computeMassProperties(core::makeUvEllipsoid(Vec3(0.15, 0.15, 0.15), 12, 6))->volume;
   for (bool guarded : {true, false}) {
@@ -199,9 +188,9 @@ TEST(Tetrahedralize, ACavityIsLeftEmpty) {
 // loose inside a hollow one) is not one tet mesh: refused up front, with their count.
 TEST(Tetrahedralize, SeparateSolidsAreRefusedWithTheirCount) {
   const core::TriangleMesh apart =
-      withShell(core::makeBox(Vec3(1, 1, 1)), core::makeBox(Vec3(1, 1, 1)), Vec3(3, 0, 0), false);
-  const core::TriangleMesh rattle = withShell(
-      withShell(core::makeBox(Vec3(2, 2, 2)), core::makeBox(Vec3(1.5, 1.5, 1.5)), Vec3::Zero(), true),
+      test::withShell(core::makeBox(Vec3(1, 1, 1)), core::makeBox(Vec3(1, 1, 1)), Vec3(3, 0, 0), false);
+  const core::TriangleMesh rattle = test::withShell(
+      test::withShell(core::makeBox(Vec3(2, 2, 2)), core::makeBox(Vec3(1.5, 1.5, 1.5)), Vec3::Zero(), true),
       core::makeUvEllipsoid(Vec3(0.3, 0.3, 0.3), 12, 6), Vec3::Zero(), false);
   for (const core::TriangleMesh& surface : {apart, rattle}) {
     const Result<TetMesh> tets = tetrahedralize(surface);
