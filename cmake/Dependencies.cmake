@@ -9,6 +9,7 @@ find_package(Spectra CONFIG REQUIRED)
 find_package(OpenMesh CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json 3.11 CONFIG REQUIRED)
+find_package(TinyGLTF CONFIG REQUIRED)  # glTF 2.0 files (io_mesh)
 find_package(SQLite3 REQUIRED)
 find_package(ZLIB REQUIRED)  # CRC-32 of the database blobs
 find_package(PkgConfig REQUIRED)

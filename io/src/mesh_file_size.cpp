@@ -12,6 +12,8 @@
 #include <unistd.h>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include <shapedb/io/mesh_io.h>
 
 #include "mesh_format.h"
@@ -108,6 +110,75 @@ MeshFileSize countLines(std::ifstream& in, bool stl) {
   return size;
 }
 
+// glTF's JSON: the .gltf file itself, or a .glb's first chunk (after a 12-byte header and the chunk's
+// length and type). Nothing for JSON over 64 MiB (buffers embedded as text: the reader will read them) or
+// a file that is not glTF.
+constexpr std::uint64_t kGltfJsonLimit = 64u << 20;
+
+std::optional<nlohmann::json> gltfJson(std::ifstream& in, bool binary, std::uintmax_t fileSize) {
+  std::uint64_t offset = 0, length = fileSize;
+  if (binary) {
+    std::array<std::uint32_t, 5> header{};  // magic, version, length; chunk length, chunk type
+    in.read(reinterpret_cast<char*>(header.data()), sizeof header);
+    if (in.gcount() != sizeof header || header[0] != 0x46546C67u || header[4] != 0x4E4F534Au)
+      return std::nullopt;
+    offset = sizeof header;
+    length = std::min<std::uint64_t>(header[3], fileSize - offset);
+  }
+  if (length > kGltfJsonLimit) return std::nullopt;
+  std::string text(static_cast<std::size_t>(length), '\0');
+  in.seekg(static_cast<std::streamoff>(offset));
+  in.read(text.data(), static_cast<std::streamsize>(length));
+  nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (json.is_discarded() || !json.is_object()) return std::nullopt;
+  return json;
+}
+
+// The triangles and vertices of the meshes a glTF file's nodes place (every mesh once where no node does),
+// from its accessors' counts, each capped by the bytes its buffers declare (so that a lying count does
+// not pass for a huge mesh). Anything malformed counts as nothing: the reader will say what it is.
+MeshFileSize gltfSize(const nlohmann::json& gltf) {
+  const auto array = [&gltf](const char* key) {
+    const auto it = gltf.find(key);
+    return it != gltf.end() && it->is_array() ? *it : nlohmann::json::array();
+  };
+  const nlohmann::json accessors = array("accessors"), meshes = array("meshes"), nodes = array("nodes");
+  std::uint64_t bufferBytes = 0;
+  for (const nlohmann::json& buffer : array("buffers"))
+    if (buffer.is_object()) bufferBytes += buffer.value("byteLength", std::uint64_t{0});
+  const auto count = [&](const nlohmann::json& index) -> std::uint64_t {
+    if (!index.is_number_unsigned() || index.get<std::uint64_t>() >= accessors.size()) return 0;
+    const nlohmann::json& a = accessors[index.get<std::size_t>()];
+    return a.is_object() ? std::min(a.value("count", std::uint64_t{0}), bufferBytes) : 0;
+  };
+  MeshFileSize size;
+  const auto addMesh = [&](const nlohmann::json& index) {
+    if (!index.is_number_unsigned() || index.get<std::uint64_t>() >= meshes.size()) return;
+    const nlohmann::json& mesh = meshes[index.get<std::size_t>()];
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) return;
+    for (const nlohmann::json& primitive : mesh["primitives"]) {
+      if (!primitive.is_object() || !primitive.contains("attributes") || !primitive["attributes"].is_object())
+        continue;
+      const int mode = primitive.value("mode", 4);
+      if (mode < 4 || mode > 6) continue;
+      const std::uint64_t vertices = count(primitive["attributes"].value("POSITION", nlohmann::json()));
+      const std::uint64_t corners = primitive.contains("indices") ? count(primitive["indices"]) : vertices;
+      size.vertices += vertices;
+      size.triangles += mode == 4 ? corners / 3 : (corners > 2 ? corners - 2 : 0);
+    }
+  };
+  bool placed = false;
+  for (const nlohmann::json& node : nodes)
+    if (node.is_object() && node.contains("mesh")) {
+      addMesh(node["mesh"]);
+      placed = true;
+    }
+  if (!placed)
+    for (std::size_t m = 0; m < meshes.size(); ++m)
+      addMesh(m);
+  return size;
+}
+
 std::optional<std::uint64_t> readUnsigned(const std::filesystem::path& path) {
   std::ifstream in(path);
   std::string text;
@@ -131,6 +202,10 @@ Result<MeshFileSize> estimateMeshFile(const std::filesystem::path& path) {
   if (ec || !in) return Error{ErrorCode::kIo, path.string() + ": cannot read file"};
 
   MeshFileSize size;
+  if (detail::isGltf(format)) {
+    const std::optional<nlohmann::json> json = gltfJson(in, format == "glb", fileSize);
+    return json ? gltfSize(*json) : size;
+  }
   if (format == "ply" || format == "off") {
     size = format == "ply" ? plyHeader(in) : offHeader(in);
     // A count the file cannot hold is a corrupt header (the reader will say so), not a huge mesh: at

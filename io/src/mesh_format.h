@@ -18,9 +18,14 @@ inline std::string lowercaseExtension(const std::filesystem::path& path) {
   return ext;
 }
 
-/// Whether `format` (as lowercaseExtension gives it) is one shapedb reads: obj, ply, off or stl.
+/// Whether `format` is glTF's, as text (gltf) or binary (glb).
+inline bool isGltf(const std::string& format) {
+  return format == "gltf" || format == "glb";
+}
+
+/// Whether `format` (as lowercaseExtension gives it) is one shapedb reads: obj, ply, off, stl, gltf or glb.
 inline bool isMeshFormat(const std::string& format) {
-  return format == "obj" || format == "ply" || format == "off" || format == "stl";
+  return format == "obj" || format == "ply" || format == "off" || format == "stl" || isGltf(format);
 }
 
 }  // namespace shapedb::io::detail

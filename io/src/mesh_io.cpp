@@ -16,6 +16,7 @@
 #include <shapedb/core/weld.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "gltf_reader.h"
 #include "mesh_format.h"
 #include "obj_writer.h"
 #include "openmesh_adapters.h"
@@ -72,10 +73,11 @@ std::string formatBytes(std::uint64_t bytes) {
 }
 
 // The file's mesh against the memory there is (LoadOptions::memoryBudget), before it is read. A file
-// under 1 MiB holds at most about 260,000 faces (some 40 MB once loaded and queried): not checked.
-Status checkFits(const std::filesystem::path& path, std::uintmax_t fileSize,
+// under 1 MiB holds at most about 260,000 faces (some 40 MB once loaded and queried): not checked, unless
+// it is a glTF file, whose buffers may be other files and whose nodes may place a mesh many times.
+Status checkFits(const std::filesystem::path& path, std::uintmax_t fileSize, const std::string& format,
                  const std::optional<std::uint64_t>& memoryBudget) {
-  if (fileSize < (1u << 20) || memoryBudget == std::uint64_t{0}) return Ok{};
+  if ((fileSize < (1u << 20) && !detail::isGltf(format)) || memoryBudget == std::uint64_t{0}) return Ok{};
   const std::optional<std::uint64_t> budget = memoryBudget ? memoryBudget : availableMemory();
   if (!budget) return Ok{};
   const Result<MeshFileSize> size = estimateMeshFile(path);
@@ -190,7 +192,8 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
   }
   if (ec) return Error{ErrorCode::kIo, directory.string() + ": " + ec.message()};
   if (files.empty())
-    return Error{ErrorCode::kIo, directory.string() + ": no mesh files (.obj, .ply, .off, .stl)"};
+    return Error{ErrorCode::kIo,
+                 directory.string() + ": no mesh files (.obj, .ply, .off, .stl, .gltf, .glb)"};
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -199,9 +202,9 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   // Format by extension, then the file itself.
   const std::string format = detail::lowercaseExtension(path);
   if (!detail::isMeshFormat(format))
-    return fileError(
-        path, ErrorCode::kUnknownFormat,
-        "unknown mesh format '" + path.extension().string() + "' (expected .obj, .ply, .off or .stl)");
+    return fileError(path, ErrorCode::kUnknownFormat,
+                     "unknown mesh format '" + path.extension().string() +
+                         "' (expected .obj, .ply, .off, .stl, .gltf or .glb)");
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return fileError(path, ErrorCode::kIo,
@@ -213,11 +216,13 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   if (format == "stl") {
     if (Status framing = checkStlFraming(path, fileSize); !framing) return framing.error();
   }
-  if (Status fits = checkFits(path, fileSize, options.memoryBudget); !fits) return fits.error();
-  Result<detail::RawPolygons> raw = format == "obj"   ? detail::readObj(path)
-                                    : format == "off" ? detail::readOff(path)
-                                    : format == "ply" ? detail::readPly(path)
-                                                      : readStl(path);
+  if (Status fits = checkFits(path, fileSize, format, options.memoryBudget); !fits) return fits.error();
+  detail::GltfReport gltf;
+  Result<detail::RawPolygons> raw = format == "obj"          ? detail::readObj(path)
+                                    : format == "off"        ? detail::readOff(path)
+                                    : format == "ply"        ? detail::readPly(path)
+                                    : detail::isGltf(format) ? detail::readGltf(path, &gltf)
+                                                             : readStl(path);
   if (!raw) return raw.error();
 
   if (!(options.scale > 0.0 && std::isfinite(options.scale)))
@@ -238,6 +243,9 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   out.mesh = std::move(tri.mesh);
   out.format = format;
   out.polygonsTriangulated = tri.polygons;
+  out.meshInstances = gltf.meshInstances;
+  out.primitivesSkipped = gltf.primitivesSkipped;
+  out.skinnedInstances = gltf.skinnedInstances;
   out.facesDropped = tri.tooFewCorners;
   out.defects = core::findDefects(out.mesh);
   // Zero-area faces with distinct corners alone (a T-junction's filler) are flipped away below once the
@@ -325,6 +333,17 @@ std::optional<double> unitScale(std::string_view unit) {
 
 std::vector<std::string> LoadedMesh::notes() const {
   std::vector<std::string> out;
+  if (meshInstances > 1)
+    out.push_back("the scene places " + std::to_string(meshInstances) +
+                  " meshes, read as one surface in the scene's frame");
+  if (primitivesSkipped > 0)
+    out.push_back(std::to_string(primitivesSkipped) +
+                  (primitivesSkipped == 1 ? " point or line primitive" : " point or line primitives") +
+                  " skipped (no surface)");
+  if (skinnedInstances > 0)
+    out.push_back(std::to_string(skinnedInstances) +
+                  (skinnedInstances == 1 ? " skinned mesh" : " skinned meshes") +
+                  " read in the bind pose, placed by the node that holds it");
   if (verticesWelded > 0)
     out.push_back(std::to_string(verticesWelded) + " coincident vertices welded" +
                   (facesCollapsedByWeld > 0 ? " (" + std::to_string(facesCollapsedByWeld) +

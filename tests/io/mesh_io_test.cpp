@@ -10,6 +10,7 @@
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "io/load_checks.h"
 #include "support/mesh_files.h"
 #include "support/test_support.h"
 
@@ -23,26 +24,9 @@ using test::asciiStl;
 using test::binaryStl;
 using test::offText;
 
-LoadedMesh mustLoad(const std::filesystem::path& path, const LoadOptions& options = {}) {
-  Result<LoadedMesh> loaded = loadMesh(path, options);
-  EXPECT_TRUE(loaded.ok()) << loaded.error().message;
-  return loaded.ok() ? *loaded : LoadedMesh{};
-}
-
-Error mustFail(const std::filesystem::path& path, const LoadOptions& options = {}) {
-  Result<LoadedMesh> loaded = loadMesh(path, options);
-  EXPECT_FALSE(loaded.ok()) << path << " loaded but should not have";
-  if (loaded.ok()) return Error{ErrorCode::kIo, ""};
-  // Every message names the file.
-  EXPECT_EQ(loaded.error().message.rfind(path.string() + ": ", 0), 0u) << loaded.error().message;
-  return loaded.error();
-}
-
-double volumeOf(const TriangleMesh& mesh) {
-  Result<core::MassProperties> mp = core::computeMassProperties(mesh);
-  EXPECT_TRUE(mp.ok()) << mp.error().message;
-  return mp.ok() ? mp->volume : 0.0;
-}
+using test_checks::mustFail;
+using test_checks::mustLoad;
+using test_checks::volumeOf;
 
 TEST(MeshIo, ObjAndPlyRoundTripExactly) {
   test::ScratchDir dir("io");

@@ -1,5 +1,8 @@
 #include "support/mesh_files.h"
 
+#include <algorithm>
+#include <cstring>
+#include <limits>
 #include <sstream>
 
 namespace shapedb::test {
@@ -67,6 +70,74 @@ std::string binaryStl(const core::TriangleMesh& mesh, std::uint32_t claimedCount
 
 std::string binaryStl(const core::TriangleMesh& mesh) {
   return binaryStl(mesh, static_cast<std::uint32_t>(mesh.triangles.size()));
+}
+
+tinygltf::Model gltfOf(const core::TriangleMesh& mesh) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "shapedb tests";
+  tinygltf::Buffer buffer;
+  tinygltf::Accessor positions;
+  positions.bufferView = 0;
+  positions.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  positions.type = TINYGLTF_TYPE_VEC3;
+  positions.count = mesh.vertices.size();
+  positions.minValues.assign(3, std::numeric_limits<double>::infinity());
+  positions.maxValues.assign(3, -std::numeric_limits<double>::infinity());
+  for (const core::Vec3& p : mesh.vertices)
+    for (int c = 0; c < 3; ++c) {
+      const float x = static_cast<float>(p[c]);
+      const auto* bytes = reinterpret_cast<const unsigned char*>(&x);
+      buffer.data.insert(buffer.data.end(), bytes, bytes + 4);
+      positions.minValues[static_cast<std::size_t>(c)] =
+          std::min<double>(positions.minValues[static_cast<std::size_t>(c)], x);
+      positions.maxValues[static_cast<std::size_t>(c)] =
+          std::max<double>(positions.maxValues[static_cast<std::size_t>(c)], x);
+    }
+  const std::size_t positionBytes = buffer.data.size();
+  for (const auto& t : mesh.triangles)
+    for (const std::uint32_t v : t) {
+      const auto* bytes = reinterpret_cast<const unsigned char*>(&v);
+      buffer.data.insert(buffer.data.end(), bytes, bytes + 4);
+    }
+  tinygltf::BufferView positionView;
+  positionView.buffer = 0;
+  positionView.byteLength = positionBytes;
+  positionView.target = TINYGLTF_TARGET_ARRAY_BUFFER;
+  tinygltf::BufferView indexView;
+  indexView.buffer = 0;
+  indexView.byteOffset = positionBytes;
+  indexView.byteLength = buffer.data.size() - positionBytes;
+  indexView.target = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
+  tinygltf::Accessor indices;
+  indices.bufferView = 1;
+  indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  indices.type = TINYGLTF_TYPE_SCALAR;
+  indices.count = 3 * mesh.triangles.size();
+  tinygltf::Primitive primitive;
+  primitive.attributes["POSITION"] = 0;
+  primitive.indices = 1;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  tinygltf::Mesh gltfMesh;
+  gltfMesh.primitives.push_back(primitive);
+  tinygltf::Node node;
+  node.mesh = 0;
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model.buffers.push_back(std::move(buffer));
+  model.bufferViews = {positionView, indexView};
+  model.accessors = {positions, indices};
+  model.meshes.push_back(gltfMesh);
+  model.nodes.push_back(node);
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+  return model;
+}
+
+bool writeGltf(const tinygltf::Model& model, const std::filesystem::path& path, bool embedBuffers) {
+  tinygltf::TinyGLTF writer;
+  const bool binary = path.extension() == ".glb";
+  return writer.WriteGltfSceneToFile(&model, path.string(), false, embedBuffers || binary, true, binary);
 }
 
 }  // namespace shapedb::test
