@@ -11,8 +11,8 @@ Long work (building, querying, fracturing) releases the GIL.
 Functions
 ---------
 load_mesh(path, *, scale=1.0) -> (V, F)
-    OBJ, PLY, OFF or STL; a surface wound inward is flipped, an open one welded where that closes it, and
-    a UserWarning naming the file says so.
+    OBJ, PLY, OFF, STL or glTF (.gltf, .glb); a surface wound inward is flipped, an open one welded where
+    that closes it, and a UserWarning naming the file says so.
 mass_properties(V, F, *, density=1.0, approximate=False) -> dict
     Exact volume, mass, area, centre of mass and inertia (about the centre of mass) of the enclosed solid.
     ``approximate=True`` accepts an open surface (vertex point masses; ``is_approximate`` says so).

@@ -454,7 +454,8 @@ PYBIND11_MODULE(_shapedb, m) {
   errorType().attr("code") = "unknown";
 
   m.def("load_mesh", &loadMesh,
-        "(V, F) of an OBJ, PLY, OFF or STL file; coordinates times `scale` (the file's unit in metres).",
+        "(V, F) of an OBJ, PLY, OFF, STL or glTF (.gltf, .glb) file; coordinates times `scale` (the file's "
+        "unit in metres).",
         "path"_a, py::kw_only(), "scale"_a = 1.0);
   m.def(
       "mass_properties",

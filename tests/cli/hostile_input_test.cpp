@@ -73,6 +73,14 @@ TriangleMesh translated(TriangleMesh mesh, const Vec3& d) {
   return mesh;
 }
 
+/// The bytes of a glTF file that tinygltf writes for `model` (a .glb, or a .gltf with its buffer embedded).
+std::string gltfBytes(const tinygltf::Model& model, const char* extension) {
+  const test::ScratchDir dir("hostile-gltf");
+  const std::filesystem::path path = dir / (std::string("model") + extension);
+  EXPECT_TRUE(test::writeGltf(model, path));
+  return test::readFile(path);
+}
+
 /// What a case must give. An error: exit 1 and `message` in what is printed (the file is always
 /// named). A result: exit 0 and `check` holds on the query's JSON.
 struct Case {
@@ -224,6 +232,27 @@ std::vector<Case> corpus() {
          return test::objText(merged(blob, translated(blob, {1.0, 0.0, 0.0})));
        },
        "", warns("2 closed shells wound outward")},
+      // glTF: not glTF at all, an accessor whose count lies, a mesh placed twice (two solids), a box.
+      {"garbage.glb", [=] { return garbage; }, "not a valid glTF file"},
+      {"garbage.gltf", [=] { return garbage; }, "not a valid glTF file"},
+      {"count_lies.glb",
+       [=] {
+         tinygltf::Model model = test::gltfOf(box);
+         model.accessors[0].count = 1u << 30;
+         return gltfBytes(model, ".glb");
+       },
+       "1073741824 elements do not fit buffer view 0"},
+      {"placed_twice.gltf",
+       [=] {
+         tinygltf::Model model = test::gltfOf(blob);
+         tinygltf::Node again = model.nodes[0];
+         again.translation = {1.0, 0.0, 0.0};
+         model.nodes.push_back(again);
+         model.scenes[0].nodes = {0, 1};
+         return gltfBytes(model, ".gltf");
+       },
+       "", warns("2 closed shells wound outward")},
+      {"box.glb", [=] { return gltfBytes(test::gltfOf(box), ".glb"); }, "", massNear(0.3 * 0.2 * 0.1)},
       // A hollow solid: the outer blob and a smaller one wound inward inside it (a cavity).
       {"hollow_blob.obj",
        [=] {

@@ -247,6 +247,41 @@ def test_load_mesh_warns_of_what_it_did_to_the_file(tmp_path, samples):
         shapedb.mass_properties(vertices, faces)["volume"], rel=1e-12)
 
 
+def test_load_mesh_reads_a_glb_as_the_obj_it_was_made_from(tmp_path, samples):
+    """A binary glTF made here (float positions, unsigned int indices, one node moving the mesh) reads
+    back as the OBJ's surface, moved, in single precision."""
+    import json
+    import struct
+
+    vertices, faces = load(samples / "egg.obj")
+    positions = vertices.astype("<f4").tobytes()
+    indices = faces.astype("<u4").tobytes()
+    gltf = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": len(positions) + len(indices)}],
+        "bufferViews": [{"buffer": 0, "byteLength": len(positions)},
+                        {"buffer": 0, "byteOffset": len(positions), "byteLength": len(indices)}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(vertices), "type": "VEC3",
+                       "min": vertices.min(axis=0).astype("f4").tolist(),
+                       "max": vertices.max(axis=0).astype("f4").tolist()},
+                      {"bufferView": 1, "componentType": 5125, "count": faces.size, "type": "SCALAR"}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0, "translation": [1.0, 2.0, 3.0]}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0,
+    }
+    text = json.dumps(gltf).encode()
+    text += b" " * (-len(text) % 4)
+    binary = positions + indices
+    chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
+    path = tmp_path / "egg.glb"
+    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks)
+
+    glb_vertices, glb_faces = load(path)
+    np.testing.assert_array_equal(glb_faces, faces)
+    np.testing.assert_array_equal(glb_vertices, vertices.astype(np.float32).astype(np.float64) + [1.0, 2.0, 3.0])
+
+
 # ---- fracture --------------------------------------------------------------------------------------------
 
 

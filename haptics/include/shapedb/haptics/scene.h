@@ -14,7 +14,7 @@
 
 namespace shapedb::haptics {
 
-/// Every mesh file (OBJ, PLY, OFF, STL) directly in `directory`, in name order, each an object in the
+/// Every mesh file (OBJ, PLY, OFF, STL, glTF) directly in `directory`, in name order, each an object in the
 /// world frame (metres) named after its file. A file that does not read is an error naming it; a mesh
 /// that reads but cannot be queried (say, open) is loaded, and its augmentation fails in the loop with
 /// that reason. Each file is read with `options` (its unit, welding). Errors: kIo (not a directory, or no
