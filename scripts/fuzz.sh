@@ -4,7 +4,7 @@
 # (tests/fuzz/corpus/<target>, never written to).
 # New inputs go to build/<preset>/corpus/<target>; a failing input to build/<preset>/artifacts/<target>/
 # and the script fails. Keep a failing input as a regression test by copying it into tests/fuzz/corpus/<target>/.
-# Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   (default: 30 s; obj ply off stl blob database)
+# Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   (default: 30 s; obj ply off stl gltf glb blob database)
 # FUZZ_ARGS adds libFuzzer flags: FUZZ_ARGS="-fork=1 -ignore_crashes=1" keeps going after a failure.
 # FUZZ_PRESET=asan fuzzes with the asan preset's build instead (coverage recorded in io alone, not core:
 # what CI does, in the tree its ASan stage has built).
@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(obj ply off stl blob database)
+((${#targets[@]})) || targets=(obj ply off stl gltf glb blob database)
 
 preset="${FUZZ_PRESET:-fuzz}"
 fuzzers=()

@@ -1,9 +1,8 @@
-// Fuzz target: one mesh file format (kShapedbFuzzFormat: "obj", "ply", "off" or "stl", defined by each
-// target in a source that tests/fuzz/CMakeLists.txt generates), read as users'
-// files are (io::loadMesh), then, when it loads as a closed surface, the front half of a query: exact
-// mass properties and the canonical frame. Properties checked beyond "no crash, no leak, no UB":
-// every error names the file; a mesh that loads is valid (indices in range, coordinates finite); a
-// frame that is returned is finite.
+// Fuzz target: one mesh file format (kShapedbFuzzFormat: "obj", "ply", "off", "stl", "gltf" or "glb", defined
+// by each target in a source that tests/fuzz/CMakeLists.txt generates), read as users' files are
+// (io::loadMesh), then, when it loads as a closed surface, the front half of a query: exact mass properties
+// and the canonical frame. Properties checked beyond "no crash, no leak, no UB": every error names the file;
+// a mesh that loads is valid (indices in range, coordinates finite); a frame that is returned is finite.
 
 #include <cmath>
 
