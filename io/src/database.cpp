@@ -557,12 +557,14 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     if (shells.solids > 1) {
       char share[32];
       std::snprintf(share, sizeof share, "%.3g", 100.0 * shells.largestSolidShare);
-      out.physics->warnings.push_back("the surface is " + std::to_string(shells.solids) +
-                                      " closed shells wound outward (separate solids, or parts that touch or "
-                                      "overlap), not one; the largest holds " +
-                                      share +
-                                      " % of their volume: the answer is one body's, as if they were joined, "
-                                      "and may be far off; a mesh of each solid gets its own data");
+      out.physics->warnings.push_back(
+          "the surface is " + std::to_string(shells.solids) +
+          " closed shells wound outward (separate solids, or parts that touch or "
+          "overlap), not one; the largest holds " +
+          share +
+          " % of their volume: the answer is one body's, as if they were joined, "
+          "and may be far off; a mesh of each solid gets its own data, and parts that touch or "
+          "overlap become one solid with --repair");
     }
     if (shells.cavities > 0 && generated)
       out.physics->warnings.push_back(

@@ -250,7 +250,8 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     return Error{ErrorCode::kParse,
                  "the surface bounds " + std::to_string(shells->solids) +
                      " separate solids (closed shells, none a cavity of another): a tet mesh is of one "
-                     "solid, so give each its own mesh"};
+                     "solid, so give each its own mesh, or, where they are parts that touch, --repair joins "
+                     "them into one"};
   if (!options.relaxOnFailure) return tets;
   // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
   // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
