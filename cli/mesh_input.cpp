@@ -49,6 +49,10 @@ void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
                  "With --repair: voxels along the mesh's largest side")
       ->capture_default_str()
       ->check(CLI::Range(16, 1024));
+  app.add_flag_function(
+      "--keep-specks", [&flags](std::int64_t) { flags.options.dropSpecks = false; },
+      "Keep a mesh's detached parts under 0.001 of its largest part's area (a scan's floating specks),\n"
+      "which are otherwise dropped with a warning");
   app.add_option("--weld-tolerance", flags.options.weldTolerance,
                  "An open surface's vertices closer than this fraction of its bounding box's diagonal are\n"
                  "welded into one (exactly coincident ones always are)")

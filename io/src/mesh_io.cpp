@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <mutex>
+#include <utility>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/System/omstream.hh>
@@ -114,6 +116,72 @@ Triangulated triangulate(detail::RawPolygons&& raw) {
       out.mesh.triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
   }
   return out;
+}
+
+// Whether the triangles `part` of `mesh` are closed among themselves: every edge in two of them.
+bool isClosedPart(const core::TriangleMesh& mesh, const std::vector<std::uint32_t>& part) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  for (const std::uint32_t t : part)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.triangles[t][static_cast<std::size_t>(k)];
+      const std::uint32_t b = mesh.triangles[t][static_cast<std::size_t>((k + 1) % 3)];
+      ++edges[std::minmax(a, b)];
+    }
+  return std::all_of(edges.begin(), edges.end(), [](const auto& edge) { return edge.second == 2; });
+}
+
+// LoadOptions::dropSpecks: the parts under kSpeckAreaShare of the largest's area are dropped, with the
+// vertices only they used; the rest keep their order.
+void dropSpecks(LoadedMesh& loaded) {
+  core::TriangleMesh& mesh = loaded.mesh;
+  const std::vector<core::Shell> parts = core::findShells(mesh);
+  std::vector<double> areas(parts.size(), 0.0);
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    for (const std::uint32_t t : parts[i].triangles) {
+      const auto& [a, b, c] = mesh.triangles[t];
+      areas[i] +=
+          0.5 * (mesh.vertices[b] - mesh.vertices[a]).cross(mesh.vertices[c] - mesh.vertices[a]).norm();
+    }
+  const double largest = *std::max_element(areas.begin(), areas.end());
+  double total = 0.0, droppedArea = 0.0, droppedVolume = 0.0, keptVolume = 0.0;
+  std::vector<bool> dropped(mesh.triangles.size(), false);
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    total += areas[i];
+    if (areas[i] >= kSpeckAreaShare * largest) {
+      keptVolume += parts[i].volume;
+      continue;
+    }
+    ++loaded.specksDropped;
+    droppedArea += areas[i];
+    if (isClosedPart(mesh, parts[i].triangles)) droppedVolume += std::abs(parts[i].volume);
+    for (const std::uint32_t t : parts[i].triangles)
+      dropped[t] = true;
+  }
+  if (loaded.specksDropped == 0) return;
+
+  // The vertices the kept triangles use, in their order.
+  std::vector<bool> used(mesh.vertices.size(), false);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (!dropped[t])
+      for (const std::uint32_t v : mesh.triangles[t])
+        used[v] = true;
+  std::vector<std::uint32_t> renumbered(mesh.vertices.size(), detail::RawPolygons::kInvalidIndex);
+  core::TriangleMesh kept;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    if (used[v]) {
+      renumbered[v] = static_cast<std::uint32_t>(kept.vertices.size());
+      kept.vertices.push_back(mesh.vertices[v]);
+    }
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (!dropped[t])
+      kept.triangles.push_back({renumbered[mesh.triangles[t][0]], renumbered[mesh.triangles[t][1]],
+                                renumbered[mesh.triangles[t][2]]});
+  mesh = std::move(kept);
+  loaded.topology = core::analyzeTopology(mesh);
+  loaded.specksAreaShare = droppedArea / total;
+  // Of the volume, where what is kept bounds one (its shells' signed volumes sum to it).
+  if (loaded.topology.isClosed() && droppedVolume > 0.0)
+    loaded.specksVolumeShare = droppedVolume / (std::abs(keptVolume) + droppedVolume);
 }
 
 // STL through OpenMesh's reader, once checkStlFraming has checked the file's size against its count.
@@ -279,6 +347,7 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
       out.facesCollapsedByWeld = weld.facesCollapsed;
     }
   }
+  if (options.dropSpecks && out.topology.components > 1) dropSpecks(out);
   if (zeroAreaOnly) {
     if (out.topology.isClosed() && out.topology.isConsistentlyOriented()) {
       out.zeroAreaFacesFlipped = core::flipZeroAreaFaces(out.mesh);
@@ -352,6 +421,19 @@ std::vector<std::string> LoadedMesh::notes() const {
                   (topology.boundaryEdges == 0
                        ? ", which closed the surface"
                        : ", leaving " + std::to_string(topology.boundaryEdges) + " boundary edges"));
+  if (specksDropped > 0) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%zu detached %s under %g of the largest part's area dropped (specks: %.3g %% of the area",
+                  specksDropped, specksDropped == 1 ? "part" : "parts", kSpeckAreaShare,
+                  100.0 * specksAreaShare);
+    std::string note = text;
+    if (specksVolumeShare > 0.0) {
+      std::snprintf(text, sizeof text, ", %.3g %% of the volume", 100.0 * specksVolumeShare);
+      note += text;
+    }
+    out.push_back(note + ")");
+  }
   if (zeroAreaFacesFlipped > 0)
     out.push_back(
         std::to_string(zeroAreaFacesFlipped) +

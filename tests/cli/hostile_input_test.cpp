@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <shapedb/core/mass_properties.h>
 #include <shapedb/core/primitives.h>
 
 #include "support/mesh_files.h"
@@ -253,6 +254,23 @@ std::vector<Case> corpus() {
        },
        "", warns("2 closed shells wound outward")},
       {"box.glb", [=] { return gltfBytes(test::gltfOf(box), ".glb"); }, "", massNear(0.3 * 0.2 * 0.1)},
+      // A scan with floating specks (a speck of a ball and a lone triangle): dropped, then answered as the
+      // one solid it is, with a predicted error.
+      {"scan_with_specks.obj",
+       [=] {
+         TriangleMesh scan = merged(blob, translated(scaled(blob, 0.01), {0.5, 0.0, 0.0}));
+         const auto lone = static_cast<std::uint32_t>(scan.vertices.size());
+         scan.vertices.insert(scan.vertices.end(),
+                              {Vec3(0, 0, 0.5), Vec3(0.001, 0, 0.5), Vec3(0, 0.001, 0.5)});
+         scan.triangles.push_back({lone, lone + 1, lone + 2});
+         return test::objText(scan);
+       },
+       "",
+       [=](const nlohmann::json& q) {
+         massNear(core::computeMassProperties(blob)->volume)(q);
+         EXPECT_TRUE(q["physics"]["warnings"].empty()) << q["physics"]["warnings"].dump();
+         EXPECT_TRUE(q.contains("predicted_frequency_error"));
+       }},
       // A hollow solid: the outer blob and a smaller one wound inward inside it (a cavity).
       {"hollow_blob.obj",
        [=] {

@@ -1,5 +1,6 @@
 #include <cstring>
 #include <fstream>
+#include <numbers>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -312,6 +313,50 @@ TEST(MeshIo, AShellWoundInwardIsACavityOnlyInsideASolid) {
     const LoadedMesh asRead = mustLoad(path, {.orientOutward = false});
     EXPECT_EQ(asRead.shellsTurnedOutward, 0u) << c.name;
   }
+}
+
+TEST(MeshIo, DetachedSpecksAreDroppedAndSaidSo) {
+  test::ScratchDir dir("io-specks");
+  const TriangleMesh ball = core::makeIcosphere(1.0, 3);  // area 4π
+  // Beside the ball, as a scan leaves them: two closed specks (tiny balls, area shares 1.6e-5 and 1e-4)
+  // and an open one (a lone triangle).
+  TriangleMesh scan = test::withShell(ball, ball, Vec3(3, 0, 0), false, 0.004);
+  scan = test::withShell(scan, ball, Vec3(0, 3, 0), false, 0.01);
+  const auto lone = static_cast<std::uint32_t>(scan.vertices.size());
+  scan.vertices.insert(scan.vertices.end(), {Vec3(0, 0, 3), Vec3(0.01, 0, 3), Vec3(0, 0.01, 3)});
+  scan.triangles.push_back({lone, lone + 1, lone + 2});
+  ASSERT_TRUE(saveMesh(scan, dir / "scan.obj").ok());
+
+  const LoadedMesh loaded = mustLoad(dir / "scan.obj");
+  EXPECT_EQ(loaded.specksDropped, 3u);
+  EXPECT_EQ(loaded.mesh.vertices, ball.vertices);  // the ball's, in their order
+  EXPECT_EQ(loaded.mesh.triangles, ball.triangles);
+  EXPECT_TRUE(loaded.topology.isClosed());
+  const double ballArea = 4.0 * std::numbers::pi * 1.0;
+  EXPECT_NEAR(loaded.specksAreaShare,
+              (0.004 * 0.004 + 0.01 * 0.01 + 0.5e-4 / ballArea) /
+                  (1.0 + 0.004 * 0.004 + 0.01 * 0.01 + 0.5e-4 / ballArea),
+              0.02 * loaded.specksAreaShare);
+  EXPECT_NEAR(loaded.specksVolumeShare,
+              (std::pow(0.004, 3) + std::pow(0.01, 3)) / (1.0 + std::pow(0.004, 3) + std::pow(0.01, 3)),
+              1e-9);
+  ASSERT_EQ(loaded.notes().size(), 1u);
+  EXPECT_NE(loaded.notes()[0].find("3 detached parts under 0.001 of the largest part's area dropped"),
+            std::string::npos)
+      << loaded.notes()[0];
+
+  // Kept when asked: the lone triangle leaves the surface open.
+  const LoadedMesh kept = mustLoad(dir / "scan.obj", {.dropSpecks = false});
+  EXPECT_EQ(kept.specksDropped, 0u);
+  EXPECT_EQ(kept.mesh.triangles.size(), scan.triangles.size());
+  EXPECT_FALSE(kept.topology.isClosed());
+
+  // A part over the share is no speck: two solids, both kept.
+  const TriangleMesh pair = test::withShell(ball, ball, Vec3(3, 0, 0), false, 0.04);  // share 1.6e-3
+  ASSERT_TRUE(saveMesh(pair, dir / "pair.obj").ok());
+  const LoadedMesh both = mustLoad(dir / "pair.obj");
+  EXPECT_EQ(both.specksDropped, 0u);
+  EXPECT_EQ(both.topology.components, 2u);
 }
 
 TEST(MeshIo, ASurfaceWoundInwardIsFlippedAtLoadAndSaysSo) {

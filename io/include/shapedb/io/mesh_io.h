@@ -33,6 +33,10 @@ struct LoadOptions {
   /// Vertices closer than this fraction of the bounding box's diagonal are coincident; 0: exactly equal
   /// positions only.
   double weldTolerance = 0.0;
+  /// A surface of several parts (edge-connected components) loses those whose area is under
+  /// kSpeckAreaShare of the largest's: the floating specks a scan picks up, open or closed, which would
+  /// otherwise leave the surface open or make it several solids. LoadedMesh::specksDropped says so.
+  bool dropSpecks = true;
   /// Bytes the mesh may need. Before a file is read whole, its size is read from its header (OBJ and
   /// ASCII STL: its lines counted in one streamed pass, when the file is over 16 MiB) and the memory a
   /// query on it needs is estimated (estimateMeshMemory); a file whose estimate exceeds this is refused
@@ -70,6 +74,11 @@ std::optional<double> unitScale(std::string_view unit);
 /// (each is a pass over the rest of the surface: a scan of thousands of specks is read as it is).
 inline constexpr std::size_t kMaxShellsChecked = 64;
 
+/// LoadOptions::dropSpecks: a part of a surface under this share of its largest part's area is a speck.
+/// A closed speck at this share of the area holds about 3e-5 of the volume (the share to the power 3/2,
+/// for shapes alike), well within what a mesh's tessellation moves.
+inline constexpr double kSpeckAreaShare = 1e-3;
+
 /// A mesh read from a file, with what was learnt about it on the way in. Plain value type.
 struct LoadedMesh {
   core::TriangleMesh mesh;
@@ -90,6 +99,9 @@ struct LoadedMesh {
   /// Zero-area faces of a closed surface flipped away (core::flipZeroAreaFaces), unless
   /// allowDegenerateFaces keeps them: a surface with any left is refused as before.
   std::size_t zeroAreaFacesFlipped = 0;
+  std::size_t specksDropped = 0;    ///< parts under kSpeckAreaShare of the largest's area, dropped
+  double specksAreaShare = 0.0;     ///< their share of the surface's area as read
+  double specksVolumeShare = 0.0;   ///< the share of the volume their closed ones held (0: none closed)
   double scale = 1.0;               ///< LoadOptions::scale, applied
   double signedVolumeAsRead = 0.0;  ///< of a closed, consistent surface as read (m³), else 0
 
