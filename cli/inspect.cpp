@@ -57,6 +57,7 @@ nlohmann::json topologyJson(const io::LoadedMesh& loaded,
           {"faces_dropped", loaded.facesDropped},
           {"polygons_triangulated", loaded.polygonsTriangulated},
           {"welded_vertices", loaded.verticesWelded},
+          {"specks_dropped", loaded.specksDropped},
           {"crossing_triangle_pairs", crossings.size()},
           {"first_crossing", firstCrossing}};
 }

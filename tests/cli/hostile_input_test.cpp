@@ -268,6 +268,7 @@ std::vector<Case> corpus() {
        "",
        [=](const nlohmann::json& q) {
          massNear(core::computeMassProperties(blob)->volume)(q);
+         EXPECT_EQ(q["specks_dropped"].get<int>(), 2);
          EXPECT_TRUE(q["physics"]["warnings"].empty()) << q["physics"]["warnings"].dump();
          EXPECT_TRUE(q.contains("predicted_frequency_error"));
        }},
