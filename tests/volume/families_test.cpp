@@ -11,6 +11,7 @@
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/self_intersection.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/describe.h>
 #include <shapedb/volume/entry.h>
@@ -57,6 +58,20 @@ TEST(Families, EveryShapeOfEveryFamilyIsOneValidClosedSolidAndDeterministic) {
       EXPECT_EQ(again->triangles, mesh->triangles) << spec.name();
     }
   }
+}
+
+// A level set simplified down to a few hundred triangles can fold a thin limb into its neighbour:
+// limbed-00114 of the sweep (at the quadratic catalog's resolution) came out passing through itself,
+// and TetGen crashed on it. Such a draw is drawn again.
+TEST(Families, ALevelSetShapeNeverPassesThroughItself) {
+  const ShapeResolution catalog{.segments = 12, .stacks = 6, .stoneSubdivisions = 1};
+  const ShapeSpec spec = familySpec(Family::kLimbed, 114);
+  auto mesh = makeFamilyShape(spec, catalog);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+  EXPECT_TRUE(core::findSelfIntersections(*mesh).empty()) << spec.name();
+  EXPECT_TRUE(core::requireClosedOriented(core::analyzeTopology(*mesh)).ok()) << spec.name();
+  auto meshed = tetrahedralize(*mesh, {});
+  EXPECT_TRUE(meshed.ok()) << spec.name() << ": " << meshed.error().message;
 }
 
 // The holes of a handle, a hook's gap, a tube's bore: what makes these families non-convex is there. A

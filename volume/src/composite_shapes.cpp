@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/self_intersection.h>
 
 #include "family_shapes.h"
 
@@ -41,15 +42,18 @@ double logUniform(std::mt19937_64& rng, double lo, double hi) {
   return lo * std::exp(std::log(hi / lo) * std::uniform_real_distribution<double>(0.0, 1.0)(rng));
 }
 
-/// Draws `make` (a list of terms and the thinnest part) until its solid is one closed piece.
+/// Draws `make` (a list of terms and the thinnest part) until its solid is one closed piece whose surface
+/// does not pass through itself: simplified down to a few hundred triangles, a thin limb's or ear's level
+/// set can fold into its neighbour (limbed-00114 of the sweep did, and TetGen crashed on it).
 template <typename Make>
 Result<TriangleMesh> drawCsg(Make make, std::size_t maxTriangles) {
   Error last{ErrorCode::kNotClosed, ""};
   for (int attempt = 0; attempt < kAttempts; ++attempt) {
     auto [terms, thinnest] = make();
     Result<TriangleMesh> mesh = meshCsg(terms, thinnest, maxTriangles);
-    if (mesh) return mesh;
-    last = mesh.error();
+    if (mesh && core::findSelfIntersections(*mesh).empty()) return mesh;
+    last = mesh ? Error{ErrorCode::kSelfIntersecting, "the simplified surface passes through itself"}
+                : mesh.error();
   }
   return last;
 }

@@ -150,8 +150,9 @@ inline bool validStoneSubdivisions(int subdivisions) {
 
 /// The closed, outward-oriented surface mesh of a spec: one connected solid, which TetGen meshes.
 /// Deterministic. The families made from level sets (limbed, union) take milliseconds to
-/// tenths of a second; the others microseconds. Errors: kInvalidArgument for kUser; kNotClosed if a
-/// level-set family's sixteen draws for an index all fail to come out as one closed piece (never seen).
+/// tenths of a second; the others microseconds. Errors: kInvalidArgument for kUser; kNotClosed (or
+/// kSelfIntersecting) if a level-set family's sixteen draws for an index all fail to come out as one
+/// closed piece whose surface does not pass through itself (never seen; one draw in 400 needed a second).
 Result<core::TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolution& resolution = {});
 
 }  // namespace shapedb::volume
