@@ -352,9 +352,10 @@ io::QueryOptions queryOptions(int k, const std::string& descriptor, const py::ob
 
 // ---- module-level functions ---------------------------------------------------------------------------
 
-py::tuple loadMesh(const std::string& path, double scale) {
+py::tuple loadMesh(const std::string& path, double scale, bool keepSpecks) {
   io::LoadOptions options;
   options.scale = scale;
+  options.dropSpecks = !keepSpecks;
   Result<io::LoadedMesh> loaded = [&] {
     py::gil_scoped_release release;
     return io::loadMesh(path, options);
@@ -455,8 +456,9 @@ PYBIND11_MODULE(_shapedb, m) {
 
   m.def("load_mesh", &loadMesh,
         "(V, F) of an OBJ, PLY, OFF, STL or glTF (.gltf, .glb) file; coordinates times `scale` (the file's "
-        "unit in metres).",
-        "path"_a, py::kw_only(), "scale"_a = 1.0);
+        "unit in metres); detached parts under 0.001 of the largest part's area are dropped unless "
+        "keep_specks.",
+        "path"_a, py::kw_only(), "scale"_a = 1.0, "keep_specks"_a = false);
   m.def(
       "mass_properties",
       [](const py::object& v, const py::object& f, double density, bool approximate) {

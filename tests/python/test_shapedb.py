@@ -247,6 +247,21 @@ def test_load_mesh_warns_of_what_it_did_to_the_file(tmp_path, samples):
         shapedb.mass_properties(vertices, faces)["volume"], rel=1e-12)
 
 
+def test_load_mesh_drops_a_speck_unless_asked_to_keep_it(tmp_path, samples):
+    vertices, faces = load(samples / "egg.obj")
+    speck = vertices * 0.001 + vertices.max(axis=0) * 3.0  # a tiny egg beside the egg
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in np.vstack([vertices, speck]).tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.vstack([faces, faces + len(vertices)]).tolist()]
+    path = tmp_path / "specked.obj"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.warns(UserWarning, match=r"specked.obj: 1 detached part under 0.001 of the largest part's area"):
+        dropped_vertices, dropped_faces = load(path)
+    np.testing.assert_array_equal(dropped_vertices, vertices)
+    np.testing.assert_array_equal(dropped_faces, faces)
+    kept_vertices, kept_faces = shapedb.load_mesh(str(path), keep_specks=True)
+    assert len(kept_faces) == 2 * len(faces)
+
+
 def test_load_mesh_reads_a_glb_as_the_obj_it_was_made_from(tmp_path, samples):
     """A binary glTF made here (float positions, unsigned int indices, one node moving the mesh) reads
     back as the OBJ's surface, moved, in single precision."""
