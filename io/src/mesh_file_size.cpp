@@ -134,6 +134,14 @@ std::optional<nlohmann::json> gltfJson(std::ifstream& in, bool binary, std::uint
   return json;
 }
 
+// An object's field as an unsigned integer: `fallback` where it is missing, and 0 where it is anything but
+// an unsigned integer (a float such as 1e98 would not convert).
+std::uint64_t unsignedField(const nlohmann::json& object, const char* key, std::uint64_t fallback = 0) {
+  const auto it = object.find(key);
+  if (it == object.end()) return fallback;
+  return it->is_number_unsigned() ? it->get<std::uint64_t>() : 0;
+}
+
 // The triangles and vertices of the meshes a glTF file's nodes place (every mesh once where no node does),
 // from its accessors' counts, each capped by the bytes its buffers declare (so that a lying count does
 // not pass for a huge mesh). Anything malformed counts as nothing: the reader will say what it is.
@@ -145,11 +153,11 @@ MeshFileSize gltfSize(const nlohmann::json& gltf) {
   const nlohmann::json accessors = array("accessors"), meshes = array("meshes"), nodes = array("nodes");
   std::uint64_t bufferBytes = 0;
   for (const nlohmann::json& buffer : array("buffers"))
-    if (buffer.is_object()) bufferBytes += buffer.value("byteLength", std::uint64_t{0});
+    if (buffer.is_object()) bufferBytes += unsignedField(buffer, "byteLength");
   const auto count = [&](const nlohmann::json& index) -> std::uint64_t {
     if (!index.is_number_unsigned() || index.get<std::uint64_t>() >= accessors.size()) return 0;
     const nlohmann::json& a = accessors[index.get<std::size_t>()];
-    return a.is_object() ? std::min(a.value("count", std::uint64_t{0}), bufferBytes) : 0;
+    return a.is_object() ? std::min(unsignedField(a, "count"), bufferBytes) : 0;
   };
   MeshFileSize size;
   const auto addMesh = [&](const nlohmann::json& index) {
@@ -159,9 +167,10 @@ MeshFileSize gltfSize(const nlohmann::json& gltf) {
     for (const nlohmann::json& primitive : mesh["primitives"]) {
       if (!primitive.is_object() || !primitive.contains("attributes") || !primitive["attributes"].is_object())
         continue;
-      const int mode = primitive.value("mode", 4);
+      const std::uint64_t mode = unsignedField(primitive, "mode", 4);
       if (mode < 4 || mode > 6) continue;
-      const std::uint64_t vertices = count(primitive["attributes"].value("POSITION", nlohmann::json()));
+      const nlohmann::json& attributes = primitive["attributes"];
+      const std::uint64_t vertices = attributes.contains("POSITION") ? count(attributes["POSITION"]) : 0;
       const std::uint64_t corners = primitive.contains("indices") ? count(primitive["indices"]) : vertices;
       size.vertices += vertices;
       size.triangles += mode == 4 ? corners / 3 : (corners > 2 ? corners - 2 : 0);
