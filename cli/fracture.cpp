@@ -108,9 +108,11 @@ Command addFractureCommand(CLI::App& parent) {
       ->required()
       ->check(CLI::Range(1, 1000));
   app->add_option("--out", o->out, "Directory for fragment-000.obj, fragment-001.obj, ...")->required();
-  app->add_option("--format", o->format, "File format of the fragments")
+  app->add_option("--format", o->format,
+                  "File format of the fragments: obj or ply (double precision), or glb or gltf for a game\n"
+                  "engine (single precision about each fragment's centre)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"obj", "ply"}));
+      ->check(CLI::IsMember({"obj", "ply", "glb", "gltf"}));
   addFractureFlags(*app, o->fracture);
   addMeshLoadFlags(*app, o->load);
   return {app, [o] { return runFracture(*o); }};

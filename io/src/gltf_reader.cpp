@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <string>
 #include <tiny_gltf.h>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+
+#include <shapedb/core/triangle_mesh.h>
 
 #include "mesh_format.h"
 
@@ -458,6 +461,83 @@ Result<RawPolygons> readGltf(const std::filesystem::path& path, GltfReport* repo
   Result<RawPolygons> raw = Reader(path, model).read(local);
   if (raw && report) *report = local;
   return raw;
+}
+
+Status writeGltf(const core::TriangleMesh& mesh, const std::filesystem::path& path) {
+  const core::Bounds bounds = core::computeBounds(mesh);
+  const core::Vec3 centre = 0.5 * (bounds.min + bounds.max);
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "shapedb";
+  tinygltf::Buffer buffer;
+  const auto append = [&buffer](const auto& value) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
+    buffer.data.insert(buffer.data.end(), bytes, bytes + sizeof value);
+  };
+  tinygltf::Accessor positions;
+  positions.bufferView = 0;
+  positions.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  positions.type = TINYGLTF_TYPE_VEC3;
+  positions.count = mesh.vertices.size();
+  // glTF wants the positions' bounds exactly as stored: kept in float.
+  std::array<float, 3> lo, hi;
+  lo.fill(std::numeric_limits<float>::infinity());
+  hi.fill(-std::numeric_limits<float>::infinity());
+  for (const core::Vec3& p : mesh.vertices)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const auto x =
+          static_cast<float>(p[static_cast<Eigen::Index>(c)] - centre[static_cast<Eigen::Index>(c)]);
+      append(x);
+      lo[c] = std::min(lo[c], x);
+      hi[c] = std::max(hi[c], x);
+    }
+  positions.minValues.assign(lo.begin(), lo.end());
+  positions.maxValues.assign(hi.begin(), hi.end());
+  const std::size_t positionBytes = buffer.data.size();
+  for (const auto& t : mesh.triangles)
+    for (const std::uint32_t v : t)
+      append(v);
+  tinygltf::BufferView positionView, indexView;
+  positionView.buffer = indexView.buffer = 0;
+  positionView.byteLength = positionBytes;
+  positionView.target = TINYGLTF_TARGET_ARRAY_BUFFER;
+  indexView.byteOffset = positionBytes;
+  indexView.byteLength = buffer.data.size() - positionBytes;
+  indexView.target = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
+  tinygltf::Accessor indices;
+  indices.bufferView = 1;
+  indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  indices.type = TINYGLTF_TYPE_SCALAR;
+  indices.count = 3 * mesh.triangles.size();
+  tinygltf::Primitive primitive;
+  primitive.attributes["POSITION"] = 0;
+  primitive.indices = 1;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  tinygltf::Mesh gltfMesh;
+  gltfMesh.primitives.push_back(primitive);
+  tinygltf::Node node;
+  node.mesh = 0;
+  node.translation = {centre.x(), centre.y(), centre.z()};
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model.buffers.push_back(std::move(buffer));
+  model.bufferViews = {positionView, indexView};
+  model.accessors = {positions, indices};
+  model.meshes.push_back(std::move(gltfMesh));
+  model.nodes.push_back(std::move(node));
+  model.scenes.push_back(std::move(scene));
+  model.defaultScene = 0;
+
+  bool written = false;
+  try {
+    tinygltf::TinyGLTF writer;
+    const bool binary = lowercaseExtension(path) == "glb";
+    written = writer.WriteGltfSceneToFile(&model, path.string(), false, true, !binary, binary);
+  } catch (const std::exception& e) {
+    return fileError(path, ErrorCode::kIo, std::string("cannot write glTF: ") + e.what());
+  }
+  if (!written) return fileError(path, ErrorCode::kIo, "cannot write file");
+  return Ok{};
 }
 
 }  // namespace shapedb::io::detail

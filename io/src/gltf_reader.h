@@ -1,8 +1,9 @@
 #pragma once
 
 // glTF 2.0 (.gltf with its buffers, or one .glb), the format game engines and DCC tools exchange props
-// in, read through tinygltf (Debian's libtinygltf). tinygltf parses the JSON and loads the buffers; the
-// geometry is read here, every accessor checked against the bytes of its buffer before it is read.
+// in, read (and written) through tinygltf (Debian's libtinygltf). tinygltf parses the JSON and loads the
+// buffers; the geometry is read here, every accessor checked against the bytes of its buffer before it is
+// read.
 
 #include <cstddef>
 #include <filesystem>
@@ -33,5 +34,12 @@ struct GltfReport {
 /// EXT_meshopt_compression, or GPU instancing, which are not decoded; an accessor that does not fit its
 /// buffer; a node cycle), kIndexOutOfRange, kNonFinite, kEmptyMesh (no triangle in the scene).
 Result<RawPolygons> readGltf(const std::filesystem::path& path, GltfReport* report = nullptr);
+
+/// Writes `mesh` as glTF 2.0 through tinygltf's writer: a .glb, or a .gltf with its buffer embedded (one
+/// self-contained file either way). One mesh of one primitive (float positions, unsigned int indices)
+/// placed by one node whose translation, in double precision, is the mesh's bounding-box centre: the
+/// positions are stored about it, so that a fragment far from the origin keeps single precision's
+/// resolution at its own size (about 6e-8 of it), not at its distance. Errors: kIo.
+Status writeGltf(const core::TriangleMesh& mesh, const std::filesystem::path& path);
 
 }  // namespace shapedb::io::detail

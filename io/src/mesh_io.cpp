@@ -458,11 +458,13 @@ std::vector<std::string> LoadedMesh::notes() const {
 Status saveMesh(const core::TriangleMesh& mesh, const std::filesystem::path& path,
                 const SaveOptions& options) {
   const std::string format = detail::lowercaseExtension(path);
-  if (format != "obj" && format != "ply")
-    return fileError(path, ErrorCode::kUnknownFormat,
-                     "cannot write format '" + path.extension().string() + "' (expected .obj or .ply)");
+  if (format != "obj" && format != "ply" && !detail::isGltf(format))
+    return fileError(
+        path, ErrorCode::kUnknownFormat,
+        "cannot write format '" + path.extension().string() + "' (expected .obj, .ply, .gltf or .glb)");
   if (Status valid = core::validateMesh(mesh, {.allowDegenerateFaces = true}); !valid)
     return fileError(path, ErrorCode::kInvalidArgument, "refusing to write: " + valid.error().message);
+  if (detail::isGltf(format)) return detail::writeGltf(mesh, path);
 
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) return fileError(path, ErrorCode::kIo, "cannot open for writing");

@@ -129,6 +129,23 @@ TEST(FractureCli, WritesClosedFragmentsTheSameForTheSameSeedAndFeedsTheHapticLoo
     EXPECT_EQ(test::readFile(file), test::readFile(again / file.filename())) << file.filename();
   }
 
+  // --format glb: the same fragments for a game engine, read back within single precision of each.
+  const auto glb = dir / "glb";
+  test::ProcessResult asGlb =
+      test::runProcess(SHAPEDB_CLI, {"fracture", plate.string(), "--pieces", "6", "--seed", "3",
+                                     "--resolution", "48", "--format", "glb", "--out", glb.string()});
+  ASSERT_EQ(asGlb.exitCode, 0) << asGlb.err;
+  for (const auto& file : files) {
+    std::filesystem::path binary = glb / file.filename();
+    binary.replace_extension(".glb");
+    auto fromGlb = io::loadMesh(binary);
+    auto fromObj = io::loadMesh(file);
+    ASSERT_TRUE(fromGlb.ok()) << fromGlb.error().message;
+    EXPECT_TRUE(fromGlb->topology.isClosed()) << binary;
+    EXPECT_EQ(fromGlb->mesh.triangles, fromObj->mesh.triangles) << binary;
+    EXPECT_LT(test::maxVertexDifference(fromGlb->mesh, fromObj->mesh), 1e-7) << binary;
+  }
+
   // --max-triangles: the same fragments, coarser (and still closed); a count under 100 is refused.
   const auto coarse = dir / "coarse";
   test::ProcessResult few = test::runProcess(

@@ -303,6 +303,30 @@ TEST(Gltf, AMeshPlacedTwiceIsTwoSolidsAndItsSizeCountsBoth) {
   }
 }
 
+TEST(Gltf, SaveMeshWritesGlbAndGltfThatReadBackAboutTheMeshsCentre) {
+  test::ScratchDir dir("gltf");
+  // A fragment as a scan's would be, hundreds of kilometres from the origin: stored about its centre,
+  // it keeps single precision at its own size (a float of its coordinates would move it by centimetres).
+  TriangleMesh far = test::makeLopsidedBlob({0.05, 0.08, 0.035}, 3);
+  for (Vec3& p : far.vertices)
+    p += Vec3(6.4e5, -1.3e6, 0.1);
+  for (const char* name : {"far.glb", "far.gltf"}) {
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(saveMesh(far, dir / name).ok());
+    const LoadedMesh loaded = mustLoad(dir / name);
+    EXPECT_EQ(loaded.mesh.triangles, far.triangles);
+    EXPECT_TRUE(loaded.topology.isClosed());
+    EXPECT_TRUE(loaded.notes().empty());
+    EXPECT_LT(test::maxVertexDifference(loaded.mesh, far), 1e-8) << "metres";
+    EXPECT_NEAR(volumeOf(loaded.mesh), volumeOf(far), 1e-6 * volumeOf(far));
+  }
+  // One file, whatever the extension's case; nothing beside it.
+  EXPECT_EQ(
+      std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()),
+      2);
+  EXPECT_EQ(saveMesh(far, dir / "far.fbx").error().code, ErrorCode::kUnknownFormat);
+}
+
 TEST(Gltf, BrokenFilesAreRefusedWithTheirReason) {
   test::ScratchDir dir("gltf");
   const tinygltf::Model good = test::gltfOf(core::makeBox({0.3, 0.2, 0.1}));
