@@ -277,8 +277,11 @@ class Reader {
         return parseError(name + " has a sparse count out of range");
       const auto count = static_cast<std::size_t>(a.sparse.count);
       const int indexBytes = componentBytes(a.sparse.indices.componentType);
-      if (indexBytes == 0 || a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
-        return parseError(name + " has sparse indices of an unknown type");
+      const int indexType = a.sparse.indices.componentType;
+      if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+          indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+          indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        return parseError(name + "'s sparse indices must be unsigned integers");
       Result<const unsigned char*> at = viewBytes(
           a.sparse.indices.bufferView, static_cast<std::size_t>(std::max(a.sparse.indices.byteOffset, 0)),
           count, static_cast<std::size_t>(indexBytes), name + "'s sparse indices");

@@ -352,6 +352,14 @@ TEST(Gltf, BrokenFilesAreRefusedWithTheirReason) {
       {"draco.glb",
        [](tinygltf::Model& m) { m.extensionsUsed = m.extensionsRequired = {"KHR_draco_mesh_compression"}; },
        ErrorCode::kParse, "compressed (KHR_draco_mesh_compression)"},
+      {"signed_sparse_indices.glb",
+       [](tinygltf::Model& m) {
+         m.accessors[0].sparse.isSparse = true;
+         m.accessors[0].sparse.count = 1;
+         m.accessors[0].sparse.indices = {0, 1, TINYGLTF_COMPONENT_TYPE_BYTE};
+         m.accessors[0].sparse.values = {0, 0};
+       },
+       ErrorCode::kParse, "sparse indices must be unsigned integers"},
       {"lines.glb", [](tinygltf::Model& m) { m.meshes[0].primitives[0].mode = TINYGLTF_MODE_LINE; },
        ErrorCode::kEmptyMesh, "no triangles (1 point or line primitives)"},
       {"no_such_mesh.glb", [](tinygltf::Model& m) { m.nodes[0].mesh = 5; }, ErrorCode::kIndexOutOfRange,
