@@ -27,7 +27,8 @@ std::string binaryStl(const core::TriangleMesh& mesh);
 
 /// A glTF model of the mesh: one buffer (positions as floats, then indices as unsigned ints), one mesh of
 /// one triangle primitive (accessor 0 its positions, 1 its indices), placed by one node in scene 0. Tests
-/// change it (transforms, more nodes, broken accessors) before writing it.
+/// change it (transforms, more nodes, broken accessors) before writing it. Made here, not by io's glTF
+/// writer (saveMesh), so that the reader is tested on files that the code under test did not make.
 tinygltf::Model gltfOf(const core::TriangleMesh& mesh);
 /// Writes `model` with tinygltf's own writer: a .glb (binary, its first buffer inside), or a .gltf whose
 /// buffers are embedded as data URIs or written beside it as .bin files. False where tinygltf fails.
