@@ -14,6 +14,9 @@ load_mesh(path, *, scale=1.0, keep_specks=False) -> (V, F)
     OBJ, PLY, OFF, STL or glTF (.gltf, .glb); a surface wound inward is flipped, an open one welded where
     that closes it, detached specks (under 0.001 of the largest part's area) dropped, and a UserWarning
     naming the file says so.
+save_mesh(path, V, F, *, binary=True)
+    Writes OBJ or PLY (double precision; ``binary`` for PLY), or glTF (``.glb``, ``.gltf``: single precision
+    about the mesh's centre, for a game engine), by extension.
 mass_properties(V, F, *, density=1.0, approximate=False) -> dict
     Exact volume, mass, area, centre of mass and inertia (about the centre of mass) of the enclosed solid.
     ``approximate=True`` accepts an open surface (vertex point masses; ``is_approximate`` says so).
@@ -60,6 +63,7 @@ from ._shapedb import (  # noqa: F401
     mass_properties,
     materials,
     normalize,
+    save_mesh,
 )
 
 __all__ = [
@@ -75,4 +79,5 @@ __all__ = [
     "mass_properties",
     "materials",
     "normalize",
+    "save_mesh",
 ]

@@ -460,6 +460,19 @@ PYBIND11_MODULE(_shapedb, m) {
         "keep_specks.",
         "path"_a, py::kw_only(), "scale"_a = 1.0, "keep_specks"_a = false);
   m.def(
+      "save_mesh",
+      [](const std::string& path, const py::object& v, const py::object& f, bool binary) {
+        const core::TriangleMesh mesh = toMesh(v, f);
+        const Status saved = [&] {
+          py::gil_scoped_release release;  // the error is raised with the GIL held
+          return io::saveMesh(mesh, path, {.binary = binary});
+        }();
+        check(saved);
+      },
+      "Writes (V, F) as OBJ or PLY (double precision: load_mesh reads back the same vertices) or glTF "
+      "(.glb, .gltf: single precision about the mesh's centre, for a game engine), by extension.",
+      "path"_a, "vertices"_a, "faces"_a, py::kw_only(), "binary"_a = true);
+  m.def(
       "mass_properties",
       [](const py::object& v, const py::object& f, double density, bool approximate) {
         return massPropertiesDict(massOf(validMesh(v, f), density, approximate));

@@ -247,6 +247,23 @@ def test_load_mesh_warns_of_what_it_did_to_the_file(tmp_path, samples):
         shapedb.mass_properties(vertices, faces)["volume"], rel=1e-12)
 
 
+def test_save_mesh_writes_what_load_mesh_reads(tmp_path, samples):
+    vertices, faces = load(samples / "doorstop.obj")
+    far = vertices + [6.4e5, -1.3e6, 0.1]  # as a scan's coordinates may be
+    for name in ("far.obj", "far.ply"):
+        shapedb.save_mesh(str(tmp_path / name), far, faces)
+        again_vertices, again_faces = load(tmp_path / name)
+        np.testing.assert_array_equal(again_vertices, far)  # double precision, to the bit
+        np.testing.assert_array_equal(again_faces, faces)
+    for name in ("far.glb", "far.gltf"):
+        shapedb.save_mesh(str(tmp_path / name), far, faces)
+        again_vertices, again_faces = load(tmp_path / name)
+        np.testing.assert_array_equal(again_faces, faces)
+        assert np.abs(again_vertices - far).max() < 1e-7  # single precision about the centre, not the origin
+    with pytest.raises(shapedb.Error, match=r"far.fbx: cannot write format '.fbx'"):
+        shapedb.save_mesh(str(tmp_path / "far.fbx"), far, faces)
+
+
 def test_load_mesh_drops_a_speck_unless_asked_to_keep_it(tmp_path, samples):
     vertices, faces = load(samples / "egg.obj")
     speck = vertices * 0.001 + vertices.max(axis=0) * 3.0  # a tiny egg beside the egg
