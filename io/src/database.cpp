@@ -17,6 +17,7 @@
 #include <shapedb/core/error_model.h>
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/normalize.h>
+#include <shapedb/core/self_intersection.h>
 #include <shapedb/io/database.h>
 #include <shapedb/volume/describe.h>
 
@@ -428,8 +429,11 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   // A surface of several shells: separate solids, or cavities inside one (only a closed, oriented one
   // says which). The entries the catalog generates are one solid each, without cavities.
   core::ShellCount shells{.solids = 1};
-  if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented())
+  bool shellsCross = false;  // several solids that pass through each other: parts that overlap
+  if (topology.components > 1 && topology.isClosed() && topology.isConsistentlyOriented()) {
     shells = core::countShells(core::findShells(mesh));
+    if (shells.solids > 1) shellsCross = !core::findSelfIntersections(mesh).empty();
+  }
   out.times.validate = microsecondsSince(t);
 
   t = Clock::now();
@@ -557,14 +561,20 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     if (shells.solids > 1) {
       char share[32];
       std::snprintf(share, sizeof share, "%.3g", 100.0 * shells.largestSolidShare);
-      out.physics->warnings.push_back(
-          "the surface is " + std::to_string(shells.solids) +
-          " closed shells wound outward (separate solids, or parts that touch or "
-          "overlap), not one; the largest holds " +
-          share +
-          " % of their volume: the answer is one body's, as if they were joined, "
-          "and may be far off; a mesh of each solid gets its own data, and parts that touch or "
-          "overlap become one solid with --repair");
+      if (shellsCross)
+        out.physics->warnings.push_back(
+            "the surface is " + std::to_string(shells.solids) +
+            " closed shells wound outward that pass through each other (parts that overlap), not one "
+            "solid: its volume and mass count the overlap twice, and the answer is one body's, as if "
+            "they were joined, and may be far off; --repair makes them the one solid they overlap into");
+      else
+        out.physics->warnings.push_back(
+            "the surface is " + std::to_string(shells.solids) +
+            " closed shells wound outward (separate solids, or parts that touch), not one; the largest "
+            "holds " +
+            share +
+            " % of their volume: the answer is one body's, as if they were joined, and may be far off; a "
+            "mesh of each solid gets its own data, and parts that touch become one solid with --repair");
     }
     if (shells.cavities > 0 && generated)
       out.physics->warnings.push_back(

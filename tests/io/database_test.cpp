@@ -934,7 +934,16 @@ TEST(Database, CavitiesAndSeparateSolidsAreSaidAndLearnedObjectsKeepTheirCavitie
     ASSERT_TRUE(two.ok() && two->physics) << (two ? "" : two.error().message);
     EXPECT_TRUE(warned(*two, "2 closed shells wound outward"));
     EXPECT_TRUE(warned(*two, "the largest holds 50 % of their volume"));
+    EXPECT_FALSE(warned(*two, "overlap"));
     EXPECT_FALSE(two->predictedFrequencyError.has_value());
+    // Two parts that overlap: said as such, the overlap counted twice in the volume.
+    const core::TriangleMesh overlapping = test::twoUnitBoxes(core::Vec3(0.5, 0.3, 0.2));
+    auto crossed = db->query(overlapping, options);
+    ASSERT_TRUE(crossed.ok() && crossed->physics) << (crossed ? "" : crossed.error().message);
+    EXPECT_TRUE(warned(*crossed, "2 closed shells wound outward that pass through each other"));
+    EXPECT_TRUE(warned(*crossed, "count the overlap twice"));
+    EXPECT_NEAR(crossed->massProperties.volume, 2.0, 1e-12);  // the union holds 1.72
+    EXPECT_FALSE(crossed->predictedFrequencyError.has_value());
   }
   auto ids = addToDatabase(path, std::vector<NamedMesh>{{"hollow.obj", "hollow.obj", hollow}});
   ASSERT_TRUE(ids.ok()) << ids.error().message;
