@@ -42,6 +42,26 @@ void append(TriangleMesh& into, const TriangleMesh& part) {
     into.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
 }
 
+std::size_t removeUnusedVertices(TriangleMesh& mesh) {
+  constexpr std::uint32_t kUnused = 0xffffffffu;
+  std::vector<std::uint32_t> index(mesh.vertices.size(), kUnused);
+  for (const auto& t : mesh.triangles)
+    for (const std::uint32_t v : t)
+      index[v] = 0;
+  std::uint32_t kept = 0;
+  for (std::size_t v = 0; v < index.size(); ++v)
+    if (index[v] != kUnused) {
+      mesh.vertices[kept] = mesh.vertices[v];
+      index[v] = kept++;
+    }
+  const std::size_t dropped = mesh.vertices.size() - kept;
+  mesh.vertices.resize(kept);
+  for (auto& t : mesh.triangles)
+    for (std::uint32_t& v : t)
+      v = index[v];
+  return dropped;
+}
+
 TriangleMesh transformed(const TriangleMesh& mesh, const Mat4& dstFromSrc) {
   TriangleMesh out;
   out.vertices.reserve(mesh.vertices.size());

@@ -29,22 +29,8 @@ WeldReport rewrite(TriangleMesh& mesh, const std::vector<std::uint32_t>& represe
     }
     triangles.push_back(w);
   }
-  // The vertices some triangle still uses, renumbered in their original order.
-  std::vector<std::uint32_t> index(mesh.vertices.size(), kNone);
-  for (const auto& t : triangles)
-    for (const std::uint32_t v : t)
-      index[v] = 0;
-  std::uint32_t kept = 0;
-  for (std::size_t v = 0; v < index.size(); ++v)
-    if (index[v] == 0) {
-      mesh.vertices[kept] = mesh.vertices[v];
-      index[v] = kept++;
-    }
-  mesh.vertices.resize(kept);
-  for (auto& t : triangles)
-    for (std::uint32_t& v : t)
-      v = index[v];
   mesh.triangles = std::move(triangles);
+  removeUnusedVertices(mesh);
   return report;
 }
 

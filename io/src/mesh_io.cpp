@@ -159,24 +159,11 @@ void dropSpecks(LoadedMesh& loaded) {
   }
   if (loaded.specksDropped == 0) return;
 
-  // The vertices the kept triangles use, in their order.
-  std::vector<bool> used(mesh.vertices.size(), false);
+  std::size_t keptTriangles = 0;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    if (!dropped[t])
-      for (const std::uint32_t v : mesh.triangles[t])
-        used[v] = true;
-  std::vector<std::uint32_t> renumbered(mesh.vertices.size(), detail::RawPolygons::kInvalidIndex);
-  core::TriangleMesh kept;
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
-    if (used[v]) {
-      renumbered[v] = static_cast<std::uint32_t>(kept.vertices.size());
-      kept.vertices.push_back(mesh.vertices[v]);
-    }
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    if (!dropped[t])
-      kept.triangles.push_back({renumbered[mesh.triangles[t][0]], renumbered[mesh.triangles[t][1]],
-                                renumbered[mesh.triangles[t][2]]});
-  mesh = std::move(kept);
+    if (!dropped[t]) mesh.triangles[keptTriangles++] = mesh.triangles[t];
+  mesh.triangles.resize(keptTriangles);
+  core::removeUnusedVertices(mesh);
   loaded.topology = core::analyzeTopology(mesh);
   loaded.specksAreaShare = droppedArea / total;
   // Of the volume, where what is kept bounds one (its shells' signed volumes sum to it).

@@ -95,5 +95,17 @@ TEST(Weld, HugeCoordinatesAndTolerancesOutsideTheContractAgreeWithTheOracle) {
   }
 }
 
+TEST(RemoveUnusedVertices, KeepsTheUsedOnesInTheirOrder) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {9, 9, 9}, {1, 0, 0}, {0, 1, 0}, {8, 8, 8}, {0, 0, 1}};
+  mesh.triangles = {{0, 3, 2}, {0, 2, 5}, {2, 3, 5}, {0, 5, 3}};
+  EXPECT_EQ(removeUnusedVertices(mesh), 2u);
+  const std::vector<Vec3> kept = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  EXPECT_EQ(mesh.vertices, kept);
+  const std::vector<TriangleMesh::Triangle> renumbered = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  EXPECT_EQ(mesh.triangles, renumbered);
+  EXPECT_EQ(removeUnusedVertices(mesh), 0u);
+}
+
 }  // namespace
 }  // namespace shapedb::core

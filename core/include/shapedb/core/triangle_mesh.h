@@ -49,6 +49,10 @@ TriangleMesh transformed(const TriangleMesh& mesh, const Mat4& dstFromSrc);
 /// of several surfaces, nothing welded.
 void append(TriangleMesh& into, const TriangleMesh& part);
 
+/// Drops the vertices no triangle uses; the others keep their order and positions, and the triangles
+/// are renumbered to match. Returns how many were dropped. Precondition: indices in range.
+std::size_t removeUnusedVertices(TriangleMesh& mesh);
+
 /// The mesh with every triangle's winding reversed (an inside-out mesh turned right side out).
 TriangleMesh flipped(const TriangleMesh& mesh);
 
