@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <optional>
 
 #include <shapedb/core/adapt.h>
@@ -107,6 +108,38 @@ Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& que
     out.warnings.push_back("material Poisson ratio " + std::to_string(material.poissonRatio) +
                            " differs from the database's " + std::to_string(entry.modes.poissonRatio) +
                            ": mode shapes and frequency ratios are the database's");
+  return out;
+}
+
+Eigen::VectorXd blendSpectra(std::span<const SpectrumSample> samples, std::vector<double>* weights) {
+  const double nearest = samples.front().distance;
+  std::vector<double> w(samples.size(), 0.0);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const double d = samples[k].distance;
+    if (nearest <= 0.0)
+      w[k] = d <= 0.0 ? 1.0 : 0.0;
+    else if (d <= kSpectrumReach * nearest)
+      w[k] = 1.0 / d;
+  }
+  const Eigen::VectorXd& first = *samples.front().eigenvalues;
+  Eigen::VectorXd out(first.size());
+  for (Eigen::Index i = 0; i < first.size(); ++i) {
+    double sum = 0.0, logs = 0.0;
+    int blended = 0;
+    for (std::size_t k = 0; k < samples.size(); ++k)
+      if (w[k] > 0.0 && i < samples[k].eigenvalues->size()) {
+        sum += w[k];
+        logs += w[k] * std::log((*samples[k].eigenvalues)[i]);
+        ++blended;
+      }
+    out[i] = blended == 1 ? first[i] : std::exp(logs / sum);  // one sample: its own value, unrounded
+  }
+  if (weights) {
+    const double total = std::accumulate(w.begin(), w.end(), 0.0);
+    weights->resize(w.size());
+    for (std::size_t k = 0; k < w.size(); ++k)
+      (*weights)[k] = w[k] / total;
+  }
   return out;
 }
 

@@ -1,6 +1,9 @@
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -77,6 +80,100 @@ TEST(Adapt, ScalesMassFrequenciesAndModesAndPlacesTheTets) {
   EXPECT_EQ(r->warnings.size(), 1u) << "rubber's Poisson ratio is not the database's";
   EXPECT_FALSE(materialPreset("unobtainium"));
   EXPECT_FALSE(adapt(entry, q, qm, orientation, Material{"bad", -1.0, 1.0, 0.3}, {}));
+}
+
+TEST(BlendSpectra, OneSampleOrAnExactMatchIsItsOwnSpectrum) {
+  const Eigen::VectorXd a = (Eigen::VectorXd(3) << 2.0, 5.0, 9.0).finished();
+  const Eigen::VectorXd b = (Eigen::VectorXd(3) << 4.0, 6.0, 7.0).finished();
+  std::vector<double> weights;
+  const std::vector<SpectrumSample> alone{{&a, 0.3}};
+  EXPECT_EQ(blendSpectra(alone, &weights), a);
+  EXPECT_EQ(weights, std::vector<double>{1.0});
+  // At distance 0 the query is the entry's own shape: the others do not count, however near.
+  const std::vector<SpectrumSample> exact{{&a, 0.0}, {&b, 1e-9}};
+  EXPECT_EQ(blendSpectra(exact, &weights), a);
+  EXPECT_EQ(weights, (std::vector<double>{1.0, 0.0}));
+  // Two at distance 0 share it: the geometric mean.
+  const std::vector<SpectrumSample> tied{{&a, 0.0}, {&b, 0.0}};
+  const Eigen::VectorXd mean = blendSpectra(tied, &weights);
+  for (Eigen::Index i = 0; i < 3; ++i)
+    EXPECT_NEAR(mean[i], std::sqrt(a[i] * b[i]), 1e-12 * mean[i]);
+  EXPECT_EQ(weights, (std::vector<double>{0.5, 0.5}));
+}
+
+TEST(BlendSpectra, WeighsByInverseDistanceWithinReachOfTheNearest) {
+  const Eigen::VectorXd a = (Eigen::VectorXd(2) << 1.0, 4.0).finished();
+  const Eigen::VectorXd b = (Eigen::VectorXd(2) << 8.0, 4.0).finished();
+  const Eigen::VectorXd c = (Eigen::VectorXd(2) << 100.0, 100.0).finished();
+  std::vector<double> weights;
+  // b twice as far as a: weights 2/3 and 1/3, so the first mode is 1^(2/3) 8^(1/3) = 2. c lies beyond
+  // kSpectrumReach times the nearest distance: another kind of shape, left out.
+  const std::vector<SpectrumSample> samples{{&a, 0.1}, {&b, 0.2}, {&c, 0.2 * kSpectrumReach}};
+  const Eigen::VectorXd blended = blendSpectra(samples, &weights);
+  EXPECT_NEAR(blended[0], 2.0, 1e-12);
+  EXPECT_NEAR(blended[1], 4.0, 1e-12);
+  ASSERT_EQ(weights.size(), 3u);
+  EXPECT_NEAR(weights[0], 2.0 / 3.0, 1e-15);
+  EXPECT_NEAR(weights[1], 1.0 / 3.0, 1e-15);
+  EXPECT_EQ(weights[2], 0.0);
+}
+
+TEST(BlendSpectra, RandomSamplesBlendWithinTheirRangeAndScaleAsTheyDo) {
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int k = 1 + static_cast<int>(rng() % 6), m = 1 + static_cast<int>(rng() % 8);
+    std::vector<Eigen::VectorXd> spectra(static_cast<std::size_t>(k));
+    std::vector<SpectrumSample> samples;
+    double distance = 0.01 + unit(rng);
+    for (int j = 0; j < k; ++j) {
+      // The first (the nearest) has m modes; the others m or fewer: a mode is blended over those that have
+      // it.
+      const int modes = j == 0 ? m : 1 + static_cast<int>(rng() % static_cast<unsigned>(m));
+      spectra[static_cast<std::size_t>(j)] = (Eigen::VectorXd::Random(modes).array() + 1.5).exp().matrix();
+      std::sort(spectra[static_cast<std::size_t>(j)].begin(), spectra[static_cast<std::size_t>(j)].end());
+      samples.push_back({&spectra[static_cast<std::size_t>(j)], distance});
+      distance *= 1.0 + 1.5 * unit(rng);  // ascending, some beyond reach
+    }
+    std::vector<double> weights;
+    const Eigen::VectorXd blended = blendSpectra(samples, &weights);
+    ASSERT_EQ(blended.size(), m);
+    double total = 0.0;
+    for (int j = 0; j < k; ++j) {
+      const double w = weights[static_cast<std::size_t>(j)];
+      const double d = samples[static_cast<std::size_t>(j)].distance;
+      total += w;
+      EXPECT_EQ(w > 0.0, d <= kSpectrumReach * samples[0].distance) << trial << " " << j;
+      if (j > 0 && w > 0.0) {
+        EXPECT_LE(w, weights[static_cast<std::size_t>(j) - 1]);  // the nearer weighs more
+      }
+    }
+    EXPECT_NEAR(total, 1.0, 1e-12);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      // Between the least and the largest of the blended samples' values of that mode.
+      double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+      for (int j = 0; j < k; ++j)
+        if (weights[static_cast<std::size_t>(j)] > 0.0 && i < spectra[static_cast<std::size_t>(j)].size()) {
+          lo = std::min(lo, spectra[static_cast<std::size_t>(j)][i]);
+          hi = std::max(hi, spectra[static_cast<std::size_t>(j)][i]);
+        }
+      EXPECT_GE(blended[i], lo * (1.0 - 1e-12)) << trial;
+      EXPECT_LE(blended[i], hi * (1.0 + 1e-12)) << trial;
+    }
+    // A geometric mean: every spectrum scaled by s scales the blend by s; every distance scaled by t
+    // changes nothing.
+    const double s = 0.1 + 10.0 * unit(rng), t = 0.1 + 10.0 * unit(rng);
+    std::vector<Eigen::VectorXd> scaled = spectra;
+    std::vector<SpectrumSample> moved;
+    for (int j = 0; j < k; ++j) {
+      scaled[static_cast<std::size_t>(j)] *= s;
+      moved.push_back(
+          {&scaled[static_cast<std::size_t>(j)], t * samples[static_cast<std::size_t>(j)].distance});
+    }
+    const Eigen::VectorXd rescaled = blendSpectra(moved);
+    for (Eigen::Index i = 0; i < m; ++i)
+      EXPECT_NEAR(rescaled[i] / (s * blended[i]), 1.0, 1e-10) << trial;
+  }
 }
 
 }  // namespace

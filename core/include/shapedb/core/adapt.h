@@ -70,4 +70,30 @@ Result<AdaptedPhysics> adapt(const PhysicalData& entry, const Normalization& que
                              const Material& material, const RayleighDamping& damping,
                              const StretchBasis* stretch = nullptr);
 
+/// One of a query's nearest entries, for blendSpectra: its eigenvalues (ModalData::eigenvalues: unit
+/// density and Young's modulus, unit volume) and its distance to the query (Match::distance, ≥ 0).
+struct SpectrumSample {
+  const Eigen::VectorXd* eigenvalues = nullptr;
+  double distance = 0.0;
+};
+
+/// How much farther than the nearest a sample may be and still count in blendSpectra: a sample farther
+/// off is another kind of shape, not one of the entries around the query, and an entry that is the query's
+/// own shape (its learned entry, say: at a distance near 0) then answers alone. On the benchmark the
+/// second-nearest of a fracture fragment or a real object lay a median 1.0-1.2 and at most 2.8 times as
+/// far as the nearest.
+inline constexpr double kSpectrumReach = 2.0;
+
+/// The spectrum of a query from its k nearest entries (k-nearest-neighbour regression; docs/accuracy.md,
+/// "The nearest tier's spectrum"): per mode, the weighted geometric mean of the samples' eigenvalues of
+/// that rank, over the samples within kSpectrumReach times the nearest's distance that have the mode,
+/// with weights 1/distance. The database samples shapes and proportions on a grid, and a query falls
+/// between its entries: one entry's spectrum carries that entry's own offset from the query, several
+/// nearby ones' average theirs out. A sample at distance 0 is the query's own shape and answers alone
+/// (samples at distance 0 share the weight equally). As many modes as the first sample has (the
+/// nearest: its mode shapes are the answer's). `weights`, if given, receives each sample's weight (0
+/// for those out of reach; they sum to 1). Precondition: samples is not empty, the first is the nearest,
+/// every eigenvalue is finite and > 0, every distance finite and ≥ 0.
+Eigen::VectorXd blendSpectra(std::span<const SpectrumSample> samples, std::vector<double>* weights = nullptr);
+
 }  // namespace shapedb::core
