@@ -1,6 +1,6 @@
 // A fracture's burst: a mesh broken into fragments that all need physical data at one instant.
 //
-//   build/release/bin/burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--cache E]
+//   build/release/bin/burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--cache E] [--neighbours K]
 //                                 [--units mm|cm|m|in|ft]
 //
 // MESH is broken with shapedb's fracture (N Voronoi pieces, default 200; the default resolution), then the
@@ -13,7 +13,8 @@
 //     queryMany (the figure a burst replaces);
 //   - per stage, the median over the fragments of the warm one-at-a-time queries (microseconds).
 // Queries skip the fidelity report unless --fidelity is given (an interactive burst does not need it).
-// --cache sets the Database's entry cache (Database::OpenOptions::cacheEntries; its default otherwise).
+// --cache sets the Database's entry cache (Database::OpenOptions::cacheEntries; its default otherwise);
+// --neighbours, how many matches' spectra each answer's eigenvalues are blended from (QueryOptions).
 // The machine's cores are all used by the bursts (TBB); `taskset -c 0` measures one core.
 
 #include <chrono>
@@ -56,6 +57,7 @@ int main(int argc, char** argv) {
   int pieces = 200, runs = 5;
   std::optional<std::size_t> cacheEntries;
   bool fidelity = false;
+  int neighbours = io::QueryOptions{}.neighbours;
   double scale = 1.0;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--pieces") && i + 1 < argc) {
@@ -69,6 +71,8 @@ int main(int argc, char** argv) {
         return 2;
       }
       cacheEntries = static_cast<std::size_t>(entries);
+    } else if (!std::strcmp(argv[i], "--neighbours") && i + 1 < argc) {
+      neighbours = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--fidelity")) {
       fidelity = true;
     } else if (!std::strcmp(argv[i], "--units") && i + 1 < argc) {
@@ -85,9 +89,10 @@ int main(int argc, char** argv) {
       positional.push_back(argv[i]);
     }
   }
-  if (positional.size() != 2 || pieces < 1 || runs < 1) {
+  if (positional.size() != 2 || pieces < 1 || runs < 1 || neighbours < 1) {
     std::fprintf(stderr,
                  "usage: burst_bench DB MESH [--pieces N] [--runs R] [--fidelity] [--cache E]\n"
+                 "                   [--neighbours K]\n"
                  "                   [--units mm|cm|m|in|ft]\n");
     return 2;
   }
@@ -119,6 +124,7 @@ int main(int argc, char** argv) {
 
   io::QueryOptions options;
   options.fidelity = fidelity;
+  options.neighbours = neighbours;
   std::vector<double> cold, coldOpen, warm, serial;
   std::vector<double> validate, mass, describe, search, fetch, adapt, link, total;
   io::Database::OpenOptions open;

@@ -183,6 +183,30 @@ Result<core::ModalData> decodeModes(const void* data, std::size_t size) {
   return modes;
 }
 
+Result<Eigen::VectorXd> decodeEigenvalues(const void* data, std::size_t size) {
+  ByteReader r(data, size);
+  double poissonRatio = 0.0;
+  std::uint32_t rows = 0, count = 0;
+  if (!(r.get(poissonRatio) && r.get(rows) && r.get(count))) return corrupted("modes");
+  for (std::size_t i = 0; i < std::tuple_size_v<decltype(core::ModalData::rigidEigenvalues)>; ++i) {
+    double rigid = 0.0;
+    if (!r.get(rigid) || !std::isfinite(rigid)) return corrupted("modes");
+  }
+  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0 || !core::validPoissonRatio(poissonRatio))
+    return corrupted("modes");
+  Eigen::VectorXd eigenvalues(count);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    double scale = 0.0;
+    r.get(eigenvalues[i]);
+    r.get(scale);
+    r.skip(rows, sizeof(std::int16_t));
+    if (!(std::isfinite(eigenvalues[i]) && eigenvalues[i] > 0.0 && std::isfinite(scale)))
+      return corrupted("modes");
+  }
+  if (!r.atEnd()) return corrupted("modes");
+  return eigenvalues;
+}
+
 Bytes encodeMassProperties(const core::MassProperties& m) {
   ByteWriter w;
   w.put(m.density);

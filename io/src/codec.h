@@ -49,6 +49,12 @@ class ByteReader {
   bool has(std::uint64_t count, std::size_t itemBytes) const {
     return !mFailed && count <= (mSize - mOffset) / itemBytes;
   }
+  /// Passes over `count` items of `itemBytes` each; false (and the reader stays failed) past the end.
+  bool skip(std::uint64_t count, std::size_t itemBytes) {
+    if (!has(count, itemBytes)) return !(mFailed = true);
+    mOffset += static_cast<std::size_t>(count) * itemBytes;
+    return true;
+  }
   bool ok() const { return !mFailed; }
   bool atEnd() const { return !mFailed && mOffset == mSize; }
 
@@ -73,6 +79,10 @@ Result<core::TetMesh> decodeTetMesh(const void* data, std::size_t size);
 /// error below 2⁻¹⁵ of it, far under the discretization error of the FEM, at a quarter of the bytes.
 Bytes encodeModes(const core::ModalData& modes);
 Result<core::ModalData> decodeModes(const void* data, std::size_t size);
+/// The eigenvalues of an encoded ModalData alone, its shapes passed over (checked as decodeModes checks
+/// the blob's layout and the eigenvalues, not the shapes' values): what a spectrum needs, without the
+/// bulk of the entry.
+Result<Eigen::VectorXd> decodeEigenvalues(const void* data, std::size_t size);
 
 Bytes encodeMassProperties(const core::MassProperties& m);
 Result<core::MassProperties> decodeMassProperties(const void* data, std::size_t size);

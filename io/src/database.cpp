@@ -47,6 +47,10 @@ double microsecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
+/// How many entries' eigenvalues a Database keeps for QueryOptions::neighbours beyond its entry cache
+/// (about 10 MB of them).
+constexpr std::size_t kSpectraKept = 1 << 16;
+
 /// The entries nearest by shape alone that a correction's fallback morphs (QueryOptions::correctionFallback).
 constexpr std::size_t kShapeFallbacks = 3;
 
@@ -169,6 +173,9 @@ struct LearningWriter {
 struct Database::Impl {
   Impl(std::unique_ptr<LearningWriter> w, Store s) : writer(std::move(w)), store(std::move(s)) {}
   Result<std::shared_ptr<const CachedEntry>> cachedEntry(core::EntryId id);
+  /// An entry's eigenvalues: from its cached data if the cache holds them (without counting a hit or
+  /// refreshing it), else from the file's modes alone, kept in `spectra`.
+  Result<std::shared_ptr<const Eigen::VectorXd>> spectrum(core::EntryId id);
   volume::Describer& describer(core::DescriptorKind kind);
 
   // Before the reading connection: closed after it, so that it can leave the file's WAL mode.
@@ -195,6 +202,10 @@ struct Database::Impl {
   mutable std::list<std::pair<core::EntryId, std::shared_ptr<const CachedEntry>>> lru;  // front: newest
   mutable std::unordered_map<core::EntryId, decltype(lru)::iterator> cached;
   mutable std::size_t hits = 0, misses = 0;
+  /// Eigenvalues read for QueryOptions::neighbours: 20 numbers an entry, dropped all at once past
+  /// kSpectraKept entries.
+  std::mutex spectraMutex;
+  std::unordered_map<core::EntryId, std::shared_ptr<const Eigen::VectorXd>> spectra;
 };
 
 Database::Database(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
@@ -376,6 +387,26 @@ Result<std::shared_ptr<const CachedEntry>> Database::Impl::cachedEntry(core::Ent
   return result;
 }
 
+Result<std::shared_ptr<const Eigen::VectorXd>> Database::Impl::spectrum(core::EntryId id) {
+  {
+    std::lock_guard lock(cacheMutex);
+    if (const auto it = cached.find(id); it != cached.end()) {
+      const std::shared_ptr<const CachedEntry>& e = it->second->second;
+      return std::shared_ptr<const Eigen::VectorXd>(e, &e->data.modes.eigenvalues);
+    }
+  }
+  {
+    std::lock_guard lock(spectraMutex);
+    if (const auto it = spectra.find(id); it != spectra.end()) return it->second;
+  }
+  auto read = store.eigenvalues(id);
+  if (!read) return read.error();
+  auto eigenvalues = std::make_shared<const Eigen::VectorXd>(std::move(read).value());
+  std::lock_guard lock(spectraMutex);
+  if (spectra.size() >= kSpectraKept) spectra.clear();
+  return spectra.try_emplace(id, std::move(eigenvalues)).first->second;
+}
+
 Result<std::vector<core::Match>> Database::match(const core::TriangleMesh& mesh, core::DescriptorKind kind,
                                                  const core::SearchOptions& search) const {
   QueryOptions options;
@@ -415,6 +446,10 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     return Error{ErrorCode::kInvalidArgument,
                  "the stretch correction needs a database of linear tets; " + mImpl->store.path().string() +
                      " has quadratic ones (its stretch basis would need their mid-edge values)"};
+  if (options.adapt && (options.neighbours < 1 || options.neighbours > 100))
+    return Error{ErrorCode::kInvalidArgument,
+                 "the neighbours whose spectra are blended must be 1 to 100, not " +
+                     std::to_string(options.neighbours)};
   const bool correcting = options.adapt && options.correct;
   if (correcting && (options.correctionCandidates < 1 || options.correctionCandidates > 100))
     return Error{ErrorCode::kInvalidArgument, "the geometry correction's candidates must be 1 to 100"};
@@ -457,6 +492,8 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   t = Clock::now();
   core::SearchOptions search = options.search;
   if (correcting) search.k = std::max(search.k, options.correctionCandidates);
+  const bool blending = options.adapt && !options.stretchCorrection && options.neighbours > 1;
+  if (blending) search.k = std::max(search.k, options.neighbours);
   auto matches = index(options.descriptor).search(*candidates, search);
   if (!matches) return matches.error();
   out.times.search = microsecondsSince(t);
@@ -555,6 +592,22 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
         parameters().entry.damping, options.stretchCorrection ? &answered.stretchBasis() : nullptr);
     if (!adapted) return adapted.error();
     out.physics = std::move(adapted).value();
+    if (!corrected) {
+      // The nearest tier's eigenvalues from the spectra of the first matches (k-nearest-neighbour
+      // regression), the shapes the nearest's; the answered match is the first when uncorrected.
+      const std::size_t n = blending ? std::min<std::size_t>(options.neighbours, out.matches.size()) : 1;
+      std::vector<std::shared_ptr<const Eigen::VectorXd>> spectra{
+          std::shared_ptr<const Eigen::VectorXd>(entries.front(), &answered.data.modes.eigenvalues)};
+      std::vector<core::SpectrumSample> samples{{spectra.front().get(), out.matches.front().match.distance}};
+      for (std::size_t k = 1; k < n; ++k) {
+        auto e = mImpl->spectrum(out.matches[k].match.entry);
+        if (!e) return e.error();
+        spectra.push_back(std::move(e).value());
+        samples.push_back({spectra.back().get(), out.matches[k].match.distance});
+      }
+      const Eigen::VectorXd blended = core::blendSpectra(samples, &out.spectrumWeights);
+      out.physics->eigenvalues.array() *= blended.array() / answered.data.modes.eigenvalues.array();
+    }
     out.physics->warnings.insert(out.physics->warnings.end(), correctionWarnings.begin(),
                                  correctionWarnings.end());
     const bool generated = generatedEntry(out.answeredMatch());

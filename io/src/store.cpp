@@ -655,4 +655,30 @@ Result<core::PhysicalData> Store::physics(core::EntryId id) const {
   return p;
 }
 
+Result<Eigen::VectorXd> Store::eigenvalues(core::EntryId id) const {
+  Statement s(mImpl->db, "SELECT data, checksum FROM physics WHERE entry_id = ? AND part = ?");
+  if (!s.ok()) return mImpl->sqlError("reading modes");
+  s.bind(1, static_cast<std::int64_t>(id));
+  s.bind(2, static_cast<std::int64_t>(Part::kModes));
+  const std::string what = mImpl->path.string() + ": entry " + std::to_string(id) + ": " +
+                           kPartNames[static_cast<std::size_t>(Part::kModes)];
+  const int rc = s.step();
+  if (rc == SQLITE_DONE) {
+    Statement e(mImpl->db, "SELECT 1 FROM entries WHERE id = ?");
+    if (!e.ok()) return mImpl->sqlError("reading entries");
+    e.bind(1, static_cast<std::int64_t>(id));
+    if (e.step() == SQLITE_ROW) return Error{ErrorCode::kParse, what + ": missing"};
+    return Error{ErrorCode::kInvalidArgument,
+                 mImpl->path.string() + ": entry " + std::to_string(id) + ": no such entry"};
+  }
+  if (rc != SQLITE_ROW) return mImpl->sqlError("reading modes");
+  const void* blob = s.blob(0);
+  const std::size_t size = s.blobSize(0);
+  if (checksum(blob, size) != static_cast<std::uint32_t>(s.integer(1)))
+    return Error{ErrorCode::kParse, what + ": checksum mismatch (the file is corrupted)"};
+  auto eigenvalues = decodeEigenvalues(blob, size);
+  if (!eigenvalues) return withContext(eigenvalues.error(), what);
+  return eigenvalues;
+}
+
 }  // namespace shapedb::io

@@ -35,7 +35,8 @@ materials(), families()
 
 Database(path, *, cache_entries=256, descriptors=None)
     ``query(V, F, *, k=1, descriptor="centroid-voxel", material="steel", correct=False, fidelity=True,
-    approximate=False, adapt=True, correction_candidates=3) -> QueryResult``; ``query_many(meshes, ...)``
+    approximate=False, adapt=True, correction_candidates=3, neighbours=3) -> QueryResult``;
+    ``query_many(meshes, ...)``
     answers a list of (V, F) at once over all cores, in input order, a failed mesh's :class:`Error` in its
     slot; ``info()``; ``len(db)``; ``close()``; usable in ``with``. ``material`` is a preset's name or a
     dict with ``density``, ``youngs_modulus`` and ``poisson_ratio``. ``descriptors`` (say
@@ -46,7 +47,9 @@ QueryResult
     ``matches`` (best first: ``name``, ``family``, ``distance``, ``fidelity``,
     ``predicted_frequency_error``), ``match`` (the answered one), ``physics`` (``mass``, ``inertia``,
     ``frequencies`` in Hz, ``damping_ratios``, ``mode_shapes`` ``(modes, nodes, 3)``, ``tet_nodes``,
-    ``tets``, ``collision``, ``warnings``), ``link`` (per query vertex: ``tets``, ``weights`` ``(n, 4)``,
+    ``tets``, ``collision``, ``warnings``, ``spectrum_weights``: the weight of each of the first matches
+    whose spectra the eigenvalues were blended from, ``neighbours`` of them; ``[1.0]`` for one entry's own,
+    ``[]`` corrected), ``link`` (per query vertex: ``tets``, ``weights`` ``(n, 4)``,
     ``distances``), ``correction`` (with ``correct=True``), ``predicted_frequency_error``, ``times_us``.
 """
 

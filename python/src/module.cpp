@@ -233,7 +233,8 @@ py::dict physicsDict(const std::shared_ptr<const io::QueryResult>& keep) {
                   "frequencies"_a = copyOf(p.frequenciesHz()), "eigenvalues"_a = copyOf(p.eigenvalues),
                   "damping_ratios"_a = copyOf(p.dampingRatios()), "mode_shapes"_a = std::move(shapes),
                   "tet_nodes"_a = pointsView(p.tetMesh.nodes, keep), "tets"_a = indexArray(p.tetMesh.tets),
-                  "collision"_a = collisionList(p.collision), "warnings"_a = p.warnings);
+                  "collision"_a = collisionList(p.collision), "warnings"_a = p.warnings,
+                  "spectrum_weights"_a = keep->spectrumWeights);
 }
 
 /// The query's vertices in the answer's tets (QueryResult.link): per vertex its tet, its four weights and
@@ -334,9 +335,11 @@ class PyDatabase {
 };
 
 io::QueryOptions queryOptions(int k, const std::string& descriptor, const py::object& material, bool correct,
-                              bool fidelity, bool approximate, bool adapt, int candidates) {
+                              bool fidelity, bool approximate, bool adapt, int candidates, int neighbours) {
   if (k < 1) throw py::value_error("k must be at least 1, not " + std::to_string(k));
   if (candidates < 1) throw py::value_error("correction_candidates must be at least 1");
+  if (neighbours < 1 || neighbours > 100)
+    throw py::value_error("neighbours must be 1 to 100, not " + std::to_string(neighbours));
   io::QueryOptions o;
   o.search.k = k;
   o.descriptor = toKind(descriptor);
@@ -347,6 +350,7 @@ io::QueryOptions queryOptions(int k, const std::string& descriptor, const py::ob
   o.adapt = adapt;
   o.link = adapt;
   o.correctionCandidates = candidates;
+  o.neighbours = neighbours;
   return o;
 }
 
@@ -578,25 +582,25 @@ PYBIND11_MODULE(_shapedb, m) {
           "query",
           [](const PyDatabase& db, const py::object& v, const py::object& f, int k,
              const std::string& descriptor, const py::object& material, bool correct, bool fidelity,
-             bool approximate, bool adapt, int candidates) {
-            return db.query(
-                v, f,
-                queryOptions(k, descriptor, material, correct, fidelity, approximate, adapt, candidates));
+             bool approximate, bool adapt, int candidates, int neighbours) {
+            return db.query(v, f,
+                            queryOptions(k, descriptor, material, correct, fidelity, approximate, adapt,
+                                         candidates, neighbours));
           },
           "vertices"_a, "faces"_a, py::kw_only(), "k"_a = 1, "descriptor"_a = "centroid-voxel",
           "material"_a = "steel", "correct"_a = false, "fidelity"_a = true, "approximate"_a = false,
-          "adapt"_a = true, "correction_candidates"_a = 3)
+          "adapt"_a = true, "correction_candidates"_a = 3, "neighbours"_a = io::QueryOptions{}.neighbours)
       .def(
           "query_many",
           [](const PyDatabase& db, const py::iterable& meshes, int k, const std::string& descriptor,
              const py::object& material, bool correct, bool fidelity, bool approximate, bool adapt,
-             int candidates) {
+             int candidates, int neighbours) {
             return db.queryMany(meshes, queryOptions(k, descriptor, material, correct, fidelity, approximate,
-                                                     adapt, candidates));
+                                                     adapt, candidates, neighbours));
           },
           "meshes"_a, py::kw_only(), "k"_a = 1, "descriptor"_a = "centroid-voxel", "material"_a = "steel",
           "correct"_a = false, "fidelity"_a = true, "approximate"_a = false, "adapt"_a = true,
-          "correction_candidates"_a = 3)
+          "correction_candidates"_a = 3, "neighbours"_a = io::QueryOptions{}.neighbours)
       .def("info", &PyDatabase::info)
       .def("close", &PyDatabase::close)
       .def("__len__", &PyDatabase::size)

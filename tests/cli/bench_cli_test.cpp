@@ -72,7 +72,8 @@ TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
                                          "box",
                                          "centroid-voxel-stretched",
                                          "centroid-voxel-paper",
-                                         "centroid-voxel-corrected"};
+                                         "centroid-voxel-corrected",
+                                         "centroid-voxel-nearest"};
   const std::size_t m = methods.size();
   ASSERT_GE(rows.size(), 2 * m);  // 3 seeds: at least 2 fragments, every method each
   ASSERT_EQ(rows.size() % m, 0u);

@@ -55,8 +55,15 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   ASSERT_EQ(j["queries"].size(), 2u);
   const nlohmann::json& b = j["queries"][0];
   EXPECT_EQ(b["file"], box.string());
-  ASSERT_EQ(b["matches"].size(), 2u);
+  // --k 2, and the three nearest whose spectra the answer's eigenvalues are blended from (--neighbours).
+  ASSERT_EQ(b["matches"].size(), 3u);
   EXPECT_LE(b["matches"][0]["distance"].get<double>(), b["matches"][1]["distance"].get<double>());
+  ASSERT_EQ(b["physics"]["spectrum_weights"].size(), 3u);
+  double weights = 0.0;
+  for (const auto& w : b["physics"]["spectrum_weights"])
+    weights += w.get<double>();
+  EXPECT_NEAR(weights, 1.0, 1e-12);
+  EXPECT_GT(b["physics"]["spectrum_weights"][0].get<double>(), 0.0);
   for (const auto& m : b["matches"]) {
     EXPECT_GT(m["moment_term"].get<double>(), 0.0);  // no entry is 3:2:1
     EXPECT_LE(m["moment_term"].get<double>(), m["distance"].get<double>());

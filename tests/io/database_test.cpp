@@ -230,6 +230,82 @@ TEST_F(SmallDatabase, PhysicsReadBackMatchesAFreshComputation) {
   EXPECT_EQ(db->cacheStats()[0], 1u);
 }
 
+TEST_F(SmallDatabase, EveryEntrysEigenvaluesReadAloneAreThoseOfItsData) {
+  auto store = Store::open(sPath);
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  for (const EntryRecord& e : db->entries()) {
+    auto eigenvalues = store->eigenvalues(e.id);
+    ASSERT_TRUE(eigenvalues.ok()) << e.name << ": " << eigenvalues.error().message;
+    auto physics = store->physics(e.id);
+    ASSERT_TRUE(physics.ok()) << e.name;
+    EXPECT_EQ(*eigenvalues, physics->modes.eigenvalues) << e.name;
+  }
+}
+
+TEST_F(SmallDatabase, TheNearestTiersEigenvaluesBlendTheNearestMatchesSpectra) {
+  auto db = Database::open(sPath);
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  std::mt19937_64 rng(314);
+  std::uniform_real_distribution<double> stretch(0.8, 1.25);
+  std::size_t blendedQueries = 0;
+  for (std::size_t i = 0; i < db->entries().size(); ++i) {
+    // An entry's shape stretched along its axes and moved: no entry is it, several are near it.
+    const EntryRecord& e = db->entries()[i];
+    auto surface = volume::makeFamilyShape(entrySpec(e), db->parameters().resolution);
+    ASSERT_TRUE(surface.ok());
+    core::TriangleMesh query = *surface;
+    const core::Vec3 a(stretch(rng), stretch(rng), stretch(rng));
+    for (core::Vec3& v : query.vertices)
+      v = a.cwiseProduct(v);
+    query = core::transformed(query, test::randomSimilarity(rng, 3.0, 0.2, 5.0));
+    QueryOptions options;
+    options.fidelity = false;
+    options.neighbours = 3;
+    auto r = db->query(query, options);
+    ASSERT_TRUE(r.ok()) << e.name << ": " << r.error().message;
+    options.neighbours = 1;
+    auto nearest = db->query(query, options);
+    ASSERT_TRUE(nearest.ok()) << e.name << ": " << nearest.error().message;
+    ASSERT_EQ(r->matches.size(), 3u) << "the search finds as many matches as are blended";
+    ASSERT_EQ(nearest->matches.size(), 1u);
+    EXPECT_EQ(nearest->spectrumWeights, std::vector<double>{1.0});
+    ASSERT_EQ(r->matches[0].match.entry, nearest->matches[0].match.entry);
+    // The oracle: the matches' stored spectra, blended, in place of the nearest's own.
+    std::vector<std::shared_ptr<const core::PhysicalData>> data;
+    std::vector<core::SpectrumSample> samples;
+    for (const MatchReport& m : r->matches) {
+      auto p = db->physics(m.match.entry);
+      ASSERT_TRUE(p.ok());
+      data.push_back(*p);
+      samples.push_back({&data.back()->modes.eigenvalues, m.match.distance});
+    }
+    std::vector<double> weights;
+    const Eigen::VectorXd blended = core::blendSpectra(samples, &weights);
+    EXPECT_EQ(r->spectrumWeights, weights) << e.name;
+    const Eigen::VectorXd& own = data.front()->modes.eigenvalues;
+    ASSERT_EQ(r->physics->eigenvalues.size(), own.size());
+    for (Eigen::Index m = 0; m < own.size(); ++m)
+      EXPECT_NEAR(r->physics->eigenvalues[m] / nearest->physics->eigenvalues[m], blended[m] / own[m], 1e-12)
+          << e.name << " mode " << m;
+    // Only the eigenvalues: the shapes, the tets and the mass are the nearest entry's.
+    EXPECT_EQ(r->physics->modeShapes, nearest->physics->modeShapes) << e.name;
+    EXPECT_EQ(r->physics->tetMesh.nodes, nearest->physics->tetMesh.nodes) << e.name;
+    EXPECT_EQ(r->physics->massProperties.mass, nearest->physics->massProperties.mass) << e.name;
+    if (weights[1] > 0.0) ++blendedQueries;
+  }
+  // Some were blended (the others' second match, of another family here, lay beyond reach).
+  std::printf("%zu of %zu queries blended\n", blendedQueries, db->entries().size());
+  EXPECT_GT(blendedQueries, 0u);
+
+  QueryOptions bad;
+  bad.neighbours = 0;
+  auto refused = db->query(core::makeBox({1.0, 2.0, 3.0}), bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("neighbours"), std::string::npos) << refused.error().message;
+}
+
 TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerysSizeAndMaterial) {
   auto db = Database::open(sPath);
   ASSERT_TRUE(db.ok()) << db.error().message;
@@ -247,7 +323,7 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     options.search.k = 2;
     auto r = db->query(query, options);
     ASSERT_TRUE(r.ok()) << r.error().message;
-    ASSERT_EQ(r->matches.size(), 2u);
+    ASSERT_EQ(r->matches.size(), 3u);  // k = 2, and as many as the answer's spectrum may be blended from
     EXPECT_EQ(r->matches[0].match.entry, e.id) << e.name;
     ASSERT_TRUE(r->matches[0].fidelity && r->matches[1].fidelity);
     const core::Fidelity& f = *r->matches[0].fidelity;
@@ -287,6 +363,9 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
         r->entryPhysics->modes.frequenciesHz() * std::sqrt(glass.youngsModulus / glass.density) / L;
     ASSERT_EQ(p.frequenciesHz().size(), expected.size());
     EXPECT_EQ(p.stretch, core::Vec3::Ones());  // the paper's uniform scaling, by default
+    // Its own shape answers alone: the other matches lie far beyond kSpectrumReach times its distance.
+    ASSERT_EQ(r->spectrumWeights.size(), 3u);
+    EXPECT_EQ(r->spectrumWeights[0], 1.0) << e.name;
     for (Eigen::Index m = 0; m < expected.size(); ++m)
       EXPECT_NEAR(p.frequenciesHz()[m] / expected[m], 1.0, 1e-12);
     if (sampled) continue;  // the checks below need the query's own frame
@@ -808,6 +887,20 @@ TEST_F(SmallDatabase, CorruptedTruncatedAndForeignFilesAreClearErrors) {
   ASSERT_FALSE(physics.ok());
   EXPECT_NE(physics.error().message.find("entry 2: modes: checksum mismatch"), std::string::npos)
       << physics.error().message;
+  {
+    // The eigenvalues alone, as a query's neighbours are read: the same check, the same message.
+    auto store = Store::open(corrupted);
+    ASSERT_TRUE(store.ok());
+    auto eigenvalues = store->eigenvalues(2);
+    ASSERT_FALSE(eigenvalues.ok());
+    EXPECT_NE(eigenvalues.error().message.find("entry 2: modes: checksum mismatch"), std::string::npos)
+        << eigenvalues.error().message;
+    EXPECT_TRUE(store->eigenvalues(1).ok());
+    auto missing = store->eigenvalues(100000);
+    ASSERT_FALSE(missing.ok());
+    EXPECT_NE(missing.error().message.find("entry 100000: no such entry"), std::string::npos)
+        << missing.error().message;
+  }
 
   // Truncated to half its size: SQLite notices, we say which file.
   const auto truncated = sDir->path() / "truncated.db";

@@ -100,6 +100,7 @@ def check_same_answer(mine, tool):
     np.testing.assert_array_equal(physics["inertia"], tool["physics"]["inertia"])
     assert mine.link is not None and mine.link["outside_count"] == tool["link"]["outside"]
     assert mine.predicted_frequency_error == tool["predicted_frequency_error"]
+    assert physics["spectrum_weights"] == tool["physics"]["spectrum_weights"]
 
 
 @pytest.mark.parametrize("name", ["soap", "doorstop"])
@@ -111,6 +112,12 @@ def test_a_query_is_the_tools_bit_for_bit(cli, samples, database, name):
     corrected = db.query(vertices, faces, k=3, correct=True)
     check_same_answer(corrected, cli("query", database, path, "-k", 3, "--correct")["queries"][0])
     assert corrected.correction["morphs"] == 3 and corrected.correction["worst_quality"] > 0
+    assert corrected.physics["spectrum_weights"] == []  # the correction's own modes
+    nearest = db.query(vertices, faces, k=3, neighbours=1)
+    check_same_answer(nearest, cli("query", database, path, "-k", 3, "--neighbours", 1)["queries"][0])
+    assert nearest.physics["spectrum_weights"] == [1.0]
+    with pytest.raises(ValueError, match="neighbours"):
+        db.query(vertices, faces, neighbours=0)
 
 
 def test_query_results_hold_the_answers_data(samples, database):

@@ -141,6 +141,9 @@ class Store {
   /// One entry's physical data, checksums verified. Errors: kInvalidArgument (no such entry), kParse
   /// (a corrupted blob: the message names the entry and the part).
   Result<core::PhysicalData> physics(core::EntryId id) const;
+  /// One entry's eigenvalues (unit density and Young's modulus, its canonical size: ModalData::eigenvalues),
+  /// its modes' checksum verified, without decoding the rest of its data. Errors: as physics().
+  Result<Eigen::VectorXd> eigenvalues(core::EntryId id) const;
 
   /// SQLite's integrity check, then every blob read and checked against its checksum (the whole file:
   /// seconds for the default database). Errors: kIo only where SQLite cannot read at all.

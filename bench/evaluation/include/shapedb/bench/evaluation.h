@@ -23,13 +23,15 @@
 
 namespace shapedb::bench {
 
-/// What supplies a shape's physical data: the top-1 match of each descriptor, adapted (the method; the
-/// voxel kinds ranked with their moment term, core::SearchOptions::momentWeight), or the
+/// What supplies a shape's physical data: each descriptor's query as it answers by default, adapted (the
+/// method; the voxel kinds ranked with their moment term, core::SearchOptions::momentWeight; the
+/// eigenvalues blended from the nearest matches' spectra, io::QueryOptions::neighbours), or the
 /// inertia-equivalent solid ellipsoid (the precomputed sound banks of Zheng & James 2010, at their
 /// best: the exact ellipsoid rather than the nearest precomputed one) or box; the centroid-voxel match
 /// adapted with the stretch correction (core/stretch.h; its time added to the query's); the centroid-voxel
-/// match by the paper's distance alone (eq. 6, no moment term); and the centroid-voxel query with the
-/// geometry correction (volume/correction.h: the entry's tets morphed onto the shape, modes recomputed).
+/// match by the paper's distance alone (eq. 6, no moment term) and its spectrum alone (the paper's
+/// method); the centroid-voxel query with the geometry correction (volume/correction.h: the entry's tets
+/// morphed onto the shape, modes recomputed); and the centroid-voxel match's own spectrum alone.
 enum class EvaluationMethod {
   kMoment,
   kVoxel,
@@ -38,19 +40,20 @@ enum class EvaluationMethod {
   kBox,
   kCentroidVoxelStretched,
   kCentroidVoxelPaper,
-  kCentroidVoxelCorrected
+  kCentroidVoxelCorrected,
+  kCentroidVoxelNearest
 };
-inline constexpr std::array<EvaluationMethod, 8> kEvaluationMethods{
-    EvaluationMethod::kMoment,
-    EvaluationMethod::kVoxel,
-    EvaluationMethod::kCentroidVoxel,
-    EvaluationMethod::kEllipsoid,
-    EvaluationMethod::kBox,
-    EvaluationMethod::kCentroidVoxelStretched,
-    EvaluationMethod::kCentroidVoxelPaper,
-    EvaluationMethod::kCentroidVoxelCorrected};
+inline constexpr std::array<EvaluationMethod, 9> kEvaluationMethods{EvaluationMethod::kMoment,
+                                                                    EvaluationMethod::kVoxel,
+                                                                    EvaluationMethod::kCentroidVoxel,
+                                                                    EvaluationMethod::kEllipsoid,
+                                                                    EvaluationMethod::kBox,
+                                                                    EvaluationMethod::kCentroidVoxelStretched,
+                                                                    EvaluationMethod::kCentroidVoxelPaper,
+                                                                    EvaluationMethod::kCentroidVoxelCorrected,
+                                                                    EvaluationMethod::kCentroidVoxelNearest};
 /// "moment", "voxel", "centroid-voxel", "ellipsoid", "box", "centroid-voxel-stretched",
-/// "centroid-voxel-paper", "centroid-voxel-corrected".
+/// "centroid-voxel-paper", "centroid-voxel-corrected", "centroid-voxel-nearest".
 const char* toString(EvaluationMethod method);
 
 struct MethodEvaluation {
