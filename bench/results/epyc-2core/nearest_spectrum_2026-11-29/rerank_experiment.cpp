@@ -14,16 +14,25 @@ using namespace shapedb;
 int main(int argc, char** argv) {
   if (argc < 3) return 2;
   auto db = io::Database::open(argv[1]);
-  if (!db) { std::fprintf(stderr, "%s\n", db.error().message.c_str()); return 1; }
+  if (!db) {
+    std::fprintf(stderr, "%s\n", db.error().message.c_str());
+    return 1;
+  }
   std::printf("shape,rank,entry,f1,mean_dev,max_dev,max_moment,predicted,distance\n");
   for (int i = 3; i < argc; ++i) {
     auto mesh = io::loadMesh(argv[i]);
-    if (!mesh) { std::fprintf(stderr, "%s\n", mesh.error().message.c_str()); continue; }
+    if (!mesh) {
+      std::fprintf(stderr, "%s\n", mesh.error().message.c_str());
+      continue;
+    }
     io::QueryOptions options;
     options.fidelity = true;
     options.search.k = std::atoi(argv[2]);
     auto r = db->query(mesh->mesh, options);
-    if (!r || !r->physics) { std::fprintf(stderr, "%s: query failed\n", argv[i]); continue; }
+    if (!r || !r->physics) {
+      std::fprintf(stderr, "%s: query failed\n", argv[i]);
+      continue;
+    }
     std::string name = argv[i];
     name = name.substr(name.find_last_of('/') + 1);
     name = name.substr(0, name.find_last_of('.'));

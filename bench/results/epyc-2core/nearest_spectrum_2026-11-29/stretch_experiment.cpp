@@ -19,16 +19,25 @@ using core::Vec3;
 int main(int argc, char** argv) {
   if (argc < 3) return 2;
   auto db = io::Database::open(argv[1]);
-  if (!db) { std::fprintf(stderr, "%s\n", db.error().message.c_str()); return 1; }
+  if (!db) {
+    std::fprintf(stderr, "%s\n", db.error().message.c_str());
+    return 1;
+  }
   std::printf("shape,entry,f1_nearest,f1_stretched,f1_stretched_vol,ax,ay,az,det\n");
   for (int i = 2; i < argc; ++i) {
     auto mesh = io::loadMesh(argv[i]);
-    if (!mesh) { std::fprintf(stderr, "%s\n", mesh.error().message.c_str()); continue; }
+    if (!mesh) {
+      std::fprintf(stderr, "%s\n", mesh.error().message.c_str());
+      continue;
+    }
     io::QueryOptions options;
     options.fidelity = false;
     options.link = false;
     auto r = db->query(mesh->mesh, options);
-    if (!r || !r->physics) { std::fprintf(stderr, "%s: query failed\n", argv[i]); continue; }
+    if (!r || !r->physics) {
+      std::fprintf(stderr, "%s: query failed\n", argv[i]);
+      continue;
+    }
     const core::PhysicalData& entry = *r->entryPhysics;
     const Mat3& O = r->answeredMatch().match.orientation;
     const core::MassProperties tm = core::computeTetMassProperties(entry.tetMesh);
@@ -37,9 +46,13 @@ int main(int argc, char** argv) {
         O * core::covarianceFromInertia(r->normalization.canonicalMoments.asDiagonal()) * O.transpose();
     const Vec3 a = (target.diagonal().array() / body.diagonal().array()).sqrt().matrix();
     core::TetMesh stretched = entry.tetMesh;
-    for (Vec3& p : stretched.nodes) p = tm.centerOfMass + a.cwiseProduct(p - tm.centerOfMass);
+    for (Vec3& p : stretched.nodes)
+      p = tm.centerOfMass + a.cwiseProduct(p - tm.centerOfMass);
     auto modes = volume::computeModes(stretched, db->parameters().entry.modal);
-    if (!modes) { std::fprintf(stderr, "%s: %s\n", argv[i], modes.error().message.c_str()); continue; }
+    if (!modes) {
+      std::fprintf(stderr, "%s: %s\n", argv[i], modes.error().message.c_str());
+      continue;
+    }
     const double ratio = modes->eigenvalues[0] / entry.modes.eigenvalues[0];
     const double f1 = std::sqrt(r->physics->eigenvalues[0]) / (2 * M_PI);
     const double det = a.prod();
