@@ -18,6 +18,7 @@
 
 #include <tetgen.h>
 
+#include <shapedb/core/socket_io.h>
 #include <shapedb/core/spatial.h>
 #include <shapedb/volume/tetrahedralize.h>
 
@@ -106,20 +107,9 @@ TetGenOutput runTetGen(const TriangleMesh& surface, const std::vector<double>& m
 
 namespace {
 
-/// Sends all bytes on a socket; MSG_NOSIGNAL: a dead peer is an error, not a SIGPIPE.
-bool sendAll(int fd, const void* data, std::size_t bytes) {
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::send(fd, p, bytes, MSG_NOSIGNAL);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-using Deadline = std::chrono::steady_clock::time_point;
+using core::Deadline;
+using core::receiveAll;
+using core::sendAll;
 
 // testing::killNextTetGenWorkers: how many requests are still to find their worker killed.
 std::atomic<int> gWorkersToKill{0};
@@ -129,27 +119,6 @@ bool takeInjectedKill() {
   while (left > 0 && !gWorkersToKill.compare_exchange_weak(left, left - 1)) {
   }
   return left > 0;
-}
-
-/// Receives exactly `bytes`, waiting until the deadline. False on end of stream, error or timeout.
-bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline, bool& timedOut) {
-  char* p = static_cast<char*>(data);
-  while (bytes > 0) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now())
-            .count();
-    if (left <= 0) return !(timedOut = true);
-    pollfd pfd{fd, POLLIN, 0};
-    const int ready = ::poll(&pfd, 1, static_cast<int>(std::min<long long>(left, 1000)));
-    if (ready < 0 && errno != EINTR) return false;
-    if (ready <= 0) continue;
-    const ssize_t n = ::recv(fd, p, bytes, 0);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-  }
-  return true;
 }
 
 /// The child's side: requests in (switches, vertices, triangles, local volume bounds, hole points),
