@@ -145,9 +145,9 @@ Command addBenchCommand(CLI::App& parent) {
       "with the shape's mass and principal moments. Writes evaluation.csv, summary.md (printed too),\n"
       "time.png and error.png in --out. Exit status 1 if no shape could be evaluated.");
   app->add_option("DB", o->database, "Database file (from shapedb build)")->required();
-  CLI::Option* queries =
-      app->add_option("--queries", o->queries,
-                      "Directory of closed meshes (.obj, .ply, .off, .stl, .gltf, .glb) to evaluate");
+  CLI::Option* queries = app->add_option(
+      "--queries", o->queries,
+      "Directory of closed meshes (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae) to evaluate");
   CLI::Option* fractureOption = app->add_option(
       "--fracture", o->fractureMesh,
       "Instead of --queries: break this closed mesh into fragments (as shapedb fracture) and evaluate them");

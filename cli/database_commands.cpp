@@ -548,7 +548,8 @@ Command addAddCommand(CLI::App& parent) {
       "§7), computed with the database's own parameters; all are added or none. Each mesh's tets, modes\n"
       "and time are printed on stderr as it is computed: a large or thin-walled object takes minutes.");
   app->add_option("DB", o->path, "Database file")->required();
-  app->add_option("MESH", o->meshes, "Closed surface mesh files (.obj, .ply, .off, .stl, .gltf, .glb)")
+  app->add_option("MESH", o->meshes,
+                  "Closed surface mesh files (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
       ->required();
   app->add_option("--max-triangles", o->add.maxTriangles,
                   "A surface of more triangles is simplified to this many before it is meshed (no vertex\n"

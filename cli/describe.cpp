@@ -114,7 +114,8 @@ Command addDescribeCommand(CLI::App& parent) {
       "centroid of the surface in each filled cell). Prints the grid as z slices, or JSON with --json:\n"
       "'moments'; 'grid', 'occupancy' (N³ values 0/1, x fastest); 'centroids' (N³ entries, [x, y, z] in\n"
       "the canonical frame or null for an empty cell).");
-  app->add_option("MESH", options->meshPath, "Surface mesh file (.obj, .ply, .off, .stl, .gltf, .glb)")
+  app->add_option("MESH", options->meshPath,
+                  "Surface mesh file (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
       ->required();
   app->add_option("--descriptor", options->kind, "Descriptor kind")
       ->capture_default_str()

@@ -182,7 +182,8 @@ Command addDropCommand(CLI::App& parent) {
       "Prints where they came to rest, when, the energy, and the deepest penetration of the floor;\n"
       "--frames writes a PNG per frame. Needs a shapedb built with Bullet (libbullet-dev).");
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
-  app->add_option("MESH", o->meshes, "Closed meshes to drop (.obj, .ply, .off, .stl, .gltf, .glb)");
+  app->add_option("MESH", o->meshes,
+                  "Closed meshes to drop (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)");
   app->add_option("--fracture", o->fractureMesh, "Drop the fragments of this closed mesh instead");
   app->add_option("--pieces", o->fracture.pieces, "With --fracture: Voronoi seeds")
       ->capture_default_str()

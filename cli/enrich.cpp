@@ -130,7 +130,8 @@ Command addEnrichCommand(CLI::App& parent) {
       "keeps what it committed, and running it again computes only the rest (a mesh is known by a hash of\n"
       "its surface as given). Exit status 1 if any mesh failed; the others are learned all the same.");
   app->add_option("DB", o->database, "Database file (shapedb build); must be writable")->required();
-  app->add_option("MESH", o->meshes, "Closed surface mesh files (.obj, .ply, .off, .stl, .gltf, .glb)")
+  app->add_option("MESH", o->meshes,
+                  "Closed surface mesh files (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
       ->required();
   addMeshLoadFlags(*app, o->load);
   app->add_option("--workers", o->workers, "Meshes computed at once (0: one per core)")

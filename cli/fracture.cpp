@@ -103,7 +103,8 @@ Command addFractureCommand(CLI::App& parent) {
       "cell that cuts a non-convex solid in two gives two fragments). Fragments are closed meshes in the\n"
       "mesh's frame, largest first, with voxel-scale detail on the cuts; crumbs under 1e-4 of the volume\n"
       "are dropped. Deterministic per seed. 200 pieces of a plate take about 2 s.");
-  app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb)")->required();
+  app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
+      ->required();
   app->add_option("--pieces", o->fracture.pieces, "Voronoi seeds (fragments, give or take)")
       ->required()
       ->check(CLI::Range(1, 1000));

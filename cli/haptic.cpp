@@ -237,10 +237,11 @@ Command addHapticCommand(CLI::App& parent) {
       "rate, tick time percentiles, deadline misses, augmentation latency, per-object outcome. Objects that\n"
       "cannot be augmented (say, open meshes) are reported, not fatal.");
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
-  app->add_option("SCENE_DIR", o->scene,
-                  "Directory of surface meshes (.obj, .ply, .off, .stl, .gltf, .glb), each an object in "
-                  "world coordinates, "
-                  "metres");
+  app->add_option(
+      "SCENE_DIR", o->scene,
+      "Directory of surface meshes (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae), each an object in "
+      "world coordinates, "
+      "metres");
   CLI::Option* fractureOption = app->add_option(
       "--fracture", o->fractureMesh,
       "Instead of SCENE_DIR: break this closed mesh into fragments (as shapedb fracture) and use "

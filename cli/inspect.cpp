@@ -162,8 +162,9 @@ Command addInspectCommand(CLI::App& parent) {
       "that passes through itself), exact mass properties (volume, area, centre of mass,\n"
       "inertia), principal moments and axes, and the normalizing transform T = canonicalFromMesh\n"
       "(volume 1, centre of mass at the origin, principal axes on x, y, z), with flags for axes that\n"
-      "the shape leaves undetermined. Formats: OBJ, PLY, OFF, STL, glTF (.gltf, .glb).");
-  app->add_option("MESH", options->meshPath, "Surface mesh file (.obj, .ply, .off, .stl, .gltf, .glb)")
+      "the shape leaves undetermined. Formats: OBJ, PLY, OFF, STL, glTF (.gltf, .glb), FBX, COLLADA (.dae).");
+  app->add_option("MESH", options->meshPath,
+                  "Surface mesh file (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
       ->required();
   app->add_flag("--json", options->json, "Print one JSON object with stable field names instead of text");
   addMeshInputFlags(*app, options->input);

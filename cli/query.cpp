@@ -545,7 +545,7 @@ Command addQueryCommand(CLI::App& parent) {
       "answered together, spread over the machine's cores, and printed in the order given. Exit status 1\n"
       "if any mesh failed.");
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
-  app->add_option("MESH", o->meshes, "Query surface meshes (.obj, .ply, .off, .stl, .gltf, .glb)")
+  app->add_option("MESH", o->meshes, "Query surface meshes (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
       ->required();
   addMeshLoadFlags(*app, o->load);
   app->add_option("-k,--k", o->k,

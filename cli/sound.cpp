@@ -103,7 +103,8 @@ Command addSoundCommand(CLI::App& parent) {
       "a damped sinusoid (the database's Rayleigh damping), excited through the linking weights there.\n"
       "The level is normalized (peak 0.9); radiation efficiency is not modelled.");
   app->add_option("DB", o->database, "Database file (from shapedb build)")->required();
-  app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb)")->required();
+  app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
+      ->required();
   addMeshLoadFlags(*app, o->load);
   app->add_option("--out", o->out, "WAV file to write (16-bit PCM, mono)")->required();
   app->add_option("--impact", o->impact, "X,Y,Z: strike the vertex nearest this point (mesh frame, metres)")

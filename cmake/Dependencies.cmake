@@ -10,6 +10,10 @@ find_package(OpenMesh CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json 3.11 CONFIG REQUIRED)
 find_package(TinyGLTF CONFIG REQUIRED)  # glTF 2.0 files (io_mesh)
+# FBX and COLLADA files (io_mesh): assimp's C API headers. Its library is not linked: a worker process
+# loads it at run time (io/src/assimp_reader.h), so that its own copy of tinygltf, in libdraco, never
+# meets the one above.
+find_path(SHAPEDB_ASSIMP_INCLUDE_DIR assimp/cimport.h REQUIRED)
 find_package(SQLite3 REQUIRED)
 find_package(ZLIB REQUIRED)  # CRC-32 of the database blobs
 find_package(PkgConfig REQUIRED)

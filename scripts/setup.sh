@@ -12,7 +12,7 @@ packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev libtet1.5-dev libeigen3-dev
   libopenmesh-dev libspectra-dev libgtest-dev googletest libbenchmark-dev libcli11-dev
-  nlohmann-json3-dev libtinygltf-dev libsqlite3-dev libstb-dev zlib1g-dev sqlite3 libbullet-dev
+  nlohmann-json3-dev libtinygltf-dev libassimp-dev libsqlite3-dev libstb-dev zlib1g-dev sqlite3 libbullet-dev
   libsuitesparse-dev libopenblas0-pthread
   python3-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
   libopenmpi-dev openmpi-bin

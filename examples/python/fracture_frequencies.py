@@ -20,7 +20,7 @@ import shapedb
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("database", help="a database file (shapedb build)")
-    parser.add_argument("mesh", help="a closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb)")
+    parser.add_argument("mesh", help="a closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
     parser.add_argument("--pieces", type=int, default=50, help="Voronoi seeds of the fracture (default 50)")
     parser.add_argument("--seed", type=int, default=1, help="the fracture's random seed (default 1)")
     parser.add_argument("--material", default="steel", help=f"one of {', '.join(shapedb.materials())}")

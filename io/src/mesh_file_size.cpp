@@ -211,6 +211,9 @@ Result<MeshFileSize> estimateMeshFile(const std::filesystem::path& path) {
   if (ec || !in) return Error{ErrorCode::kIo, path.string() + ": cannot read file"};
 
   MeshFileSize size;
+  // FBX and COLLADA are parsed by assimp alone, in a worker process, whose count of the mesh is checked
+  // against the memory budget before the mesh enters this one (assimp_reader.h): not estimated here.
+  if (detail::isAssimpFormat(format)) return size;
   if (detail::isGltf(format)) {
     const std::optional<nlohmann::json> json = gltfJson(in, format == "glb", fileSize);
     return json ? gltfSize(*json) : size;

@@ -23,9 +23,16 @@ inline bool isGltf(const std::string& format) {
   return format == "gltf" || format == "glb";
 }
 
-/// Whether `format` (as lowercaseExtension gives it) is one shapedb reads: obj, ply, off, stl, gltf or glb.
+/// Whether `format` is one read through assimp in a worker process (assimp_reader.h): FBX and COLLADA.
+inline bool isAssimpFormat(const std::string& format) {
+  return format == "fbx" || format == "dae";
+}
+
+/// Whether `format` (as lowercaseExtension gives it) is one shapedb reads: obj, ply, off, stl, gltf, glb,
+/// fbx or dae.
 inline bool isMeshFormat(const std::string& format) {
-  return format == "obj" || format == "ply" || format == "off" || format == "stl" || isGltf(format);
+  return format == "obj" || format == "ply" || format == "off" || format == "stl" || isGltf(format) ||
+         isAssimpFormat(format);
 }
 
 }  // namespace shapedb::io::detail

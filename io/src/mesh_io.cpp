@@ -18,6 +18,7 @@
 #include <shapedb/core/weld.h>
 #include <shapedb/io/mesh_io.h>
 
+#include "assimp_reader.h"
 #include "gltf_reader.h"
 #include "mesh_format.h"
 #include "obj_writer.h"
@@ -248,7 +249,7 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
   if (ec) return Error{ErrorCode::kIo, directory.string() + ": " + ec.message()};
   if (files.empty())
     return Error{ErrorCode::kIo,
-                 directory.string() + ": no mesh files (.obj, .ply, .off, .stl, .gltf, .glb)"};
+                 directory.string() + ": no mesh files (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)"};
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -259,7 +260,7 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   if (!detail::isMeshFormat(format))
     return fileError(path, ErrorCode::kUnknownFormat,
                      "unknown mesh format '" + path.extension().string() +
-                         "' (expected .obj, .ply, .off, .stl, .gltf or .glb)");
+                         "' (expected .obj, .ply, .off, .stl, .gltf, .glb, .fbx or .dae)");
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return fileError(path, ErrorCode::kIo,
@@ -273,11 +274,18 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   }
   if (Status fits = checkFits(path, fileSize, format, options.memoryBudget); !fits) return fits.error();
   detail::GltfReport gltf;
+  detail::AssimpReport assimp;
+  const auto assimpBudget = [&]() -> std::optional<std::uint64_t> {
+    if (options.memoryBudget == std::uint64_t{0}) return std::nullopt;
+    return options.memoryBudget ? options.memoryBudget : availableMemory();
+  };
   Result<detail::RawPolygons> raw = format == "obj"          ? detail::readObj(path)
                                     : format == "off"        ? detail::readOff(path)
                                     : format == "ply"        ? detail::readPly(path)
                                     : detail::isGltf(format) ? detail::readGltf(path, &gltf)
-                                                             : readStl(path);
+                                    : detail::isAssimpFormat(format)
+                                        ? detail::readWithAssimp(path, assimpBudget(), &assimp)
+                                        : readStl(path);
   if (!raw) return raw.error();
 
   if (!(options.scale > 0.0 && std::isfinite(options.scale)))
@@ -298,8 +306,9 @@ Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions
   out.mesh = std::move(tri.mesh);
   out.format = format;
   out.polygonsTriangulated = tri.polygons;
-  out.meshInstances = gltf.meshInstances;
-  out.primitivesSkipped = gltf.primitivesSkipped;
+  out.meshInstances = gltf.meshInstances + assimp.meshInstances;
+  out.primitivesSkipped = gltf.primitivesSkipped + assimp.primitivesSkipped;
+  out.fileUnit = assimp.unit;
   out.skinnedInstances = gltf.skinnedInstances;
   out.facesDropped = tri.tooFewCorners;
   out.defects = core::findDefects(out.mesh);
@@ -396,6 +405,15 @@ std::vector<std::string> LoadedMesh::notes() const {
     out.push_back(std::to_string(primitivesSkipped) +
                   (primitivesSkipped == 1 ? " point or line primitive" : " point or line primitives") +
                   " skipped (no surface)");
+  if (fileUnit != 1.0) {
+    char unit[64];
+    std::snprintf(unit, sizeof unit, "%g", fileUnit);
+    out.push_back(std::string("the file's unit is ") + unit + " m" +
+                  (fileUnit == 0.01    ? " (centimetres, FBX's default)"
+                   : fileUnit == 0.001 ? " (millimetres)"
+                                       : "") +
+                  ": read in metres");
+  }
   if (skinnedInstances > 0)
     out.push_back(std::to_string(skinnedInstances) +
                   (skinnedInstances == 1 ? " skinned mesh" : " skinned meshes") +

@@ -11,7 +11,7 @@ Long work (building, querying, fracturing) releases the GIL.
 Functions
 ---------
 load_mesh(path, *, scale=1.0, keep_specks=False) -> (V, F)
-    OBJ, PLY, OFF, STL or glTF (.gltf, .glb); a surface wound inward is flipped, an open one welded where
+    OBJ, PLY, OFF, STL, glTF (.gltf, .glb), FBX or COLLADA (.dae); a surface wound inward is flipped, an open one welded where
     that closes it, detached specks (under 0.001 of the largest part's area) dropped, and a UserWarning
     naming the file says so.
 save_mesh(path, V, F, *, binary=True)

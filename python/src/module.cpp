@@ -459,7 +459,8 @@ PYBIND11_MODULE(_shapedb, m) {
   errorType().attr("code") = "unknown";
 
   m.def("load_mesh", &loadMesh,
-        "(V, F) of an OBJ, PLY, OFF, STL or glTF (.gltf, .glb) file; coordinates times `scale` (the file's "
+        "(V, F) of an OBJ, PLY, OFF, STL, glTF (.gltf, .glb), FBX or COLLADA (.dae) file; coordinates times "
+        "`scale` (the file's "
         "unit in metres); detached parts under 0.001 of the largest part's area are dropped unless "
         "keep_specks.",
         "path"_a, py::kw_only(), "scale"_a = 1.0, "keep_specks"_a = false);

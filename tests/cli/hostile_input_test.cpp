@@ -254,6 +254,10 @@ std::vector<Case> corpus() {
        },
        "", warns("2 closed shells wound outward")},
       {"box.glb", [=] { return gltfBytes(test::gltfOf(box), ".glb"); }, "", massNear(0.3 * 0.2 * 0.1)},
+      // FBX and COLLADA (read by assimp in a worker process): not those at all, a box.
+      {"garbage.fbx", [=] { return garbage; }, "assimp"},
+      {"garbage.dae", [=] { return garbage; }, "assimp"},
+      {"box.dae", [=] { return test::colladaText(box); }, "", massNear(0.3 * 0.2 * 0.1)},
       // A scan with floating specks (a speck of a ball and a lone triangle): dropped, then answered as the
       // one solid it is, with a predicted error.
       {"scan_with_specks.obj",

@@ -321,6 +321,33 @@ def test_load_mesh_reads_a_glb_as_the_obj_it_was_made_from(tmp_path, samples):
     np.testing.assert_array_equal(glb_vertices, vertices.astype(np.float32).astype(np.float64) + [1.0, 2.0, 3.0])
 
 
+def test_load_mesh_reads_a_collada_file_through_assimp(tmp_path, samples, cli):
+    """A COLLADA file written here, read by assimp in its worker process: the OBJ's surface in single
+    precision, placed by its node, welded as the tool reads it."""
+    vertices, faces = load(samples / "egg.obj")
+    xyz = " ".join(f"{c:.9g}" for c in vertices.ravel())
+    corners = " ".join(str(i) for i in faces.ravel())
+    path = tmp_path / "egg.dae"
+    path.write_text(
+        '<?xml version="1.0" encoding="utf-8"?>\n'
+        '<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">'
+        '<asset><unit meter="1"/><up_axis>Y_UP</up_axis></asset><library_geometries><geometry id="g"><mesh>'
+        f'<source id="p"><float_array id="a" count="{vertices.size}">{xyz}</float_array>'
+        f'<technique_common><accessor source="#a" count="{len(vertices)}" stride="3">'
+        '<param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>'
+        '</accessor></technique_common></source><vertices id="v"><input semantic="POSITION" source="#p"/></vertices>'
+        f'<triangles count="{len(faces)}"><input semantic="VERTEX" source="#v" offset="0"/><p>{corners}</p></triangles>'
+        '</mesh></geometry></library_geometries><library_visual_scenes><visual_scene id="s"><node id="n">'
+        '<translate>1 2 3</translate><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>'
+        '<scene><instance_visual_scene url="#s"/></scene></COLLADA>\n')
+    dae_vertices, dae_faces = load(path)
+    assert len(dae_faces) == len(faces)
+    tool = cli("inspect", path)
+    assert shapedb.mass_properties(dae_vertices, dae_faces)["volume"] == tool["volume"]
+    np.testing.assert_allclose(shapedb.mass_properties(dae_vertices, dae_faces)["volume"],
+                               shapedb.mass_properties(vertices, faces)["volume"], rtol=1e-5)
+
+
 # ---- fracture --------------------------------------------------------------------------------------------
 
 

@@ -28,6 +28,31 @@ std::string objText(const core::TriangleMesh& mesh) {
   return out.str();
 }
 
+std::string colladaText(const core::TriangleMesh& mesh) {
+  std::ostringstream out;
+  out.precision(9);
+  out << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+      << "<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
+      << "<asset><unit name=\"meter\" meter=\"1\"/><up_axis>Y_UP</up_axis></asset>\n"
+      << "<library_geometries><geometry id=\"mesh\"><mesh>\n<source id=\"positions\">"
+      << "<float_array id=\"xyz\" count=\"" << 3 * mesh.vertices.size() << "\">";
+  for (const core::Vec3& p : mesh.vertices)
+    out << p.x() << " " << p.y() << " " << p.z() << " ";
+  out << "</float_array>\n<technique_common><accessor source=\"#xyz\" count=\"" << mesh.vertices.size()
+      << "\" stride=\"3\"><param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/>"
+      << "<param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n"
+      << "<vertices id=\"vertices\"><input semantic=\"POSITION\" source=\"#positions\"/></vertices>\n"
+      << "<triangles count=\"" << mesh.triangles.size()
+      << "\"><input semantic=\"VERTEX\" source=\"#vertices\" offset=\"0\"/><p>";
+  for (const auto& t : mesh.triangles)
+    out << t[0] << " " << t[1] << " " << t[2] << " ";
+  out << "</p></triangles>\n</mesh></geometry></library_geometries>\n"
+      << "<library_visual_scenes><visual_scene id=\"scene\"><node id=\"node\">"
+      << "<instance_geometry url=\"#mesh\"/></node></visual_scene></library_visual_scenes>\n"
+      << "<scene><instance_visual_scene url=\"#scene\"/></scene>\n</COLLADA>\n";
+  return out.str();
+}
+
 std::string offText(const core::TriangleMesh& mesh) {
   std::ostringstream out;
   out.precision(17);

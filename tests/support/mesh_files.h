@@ -25,6 +25,10 @@ std::string asciiStl(const core::TriangleMesh& mesh);
 std::string binaryStl(const core::TriangleMesh& mesh, std::uint32_t claimedCount);
 std::string binaryStl(const core::TriangleMesh& mesh);
 
+/// COLLADA text (.dae, 9 digits): the mesh as one geometry of triangles placed by one node, in metres,
+/// Y up (as assimp reads it, unturned).
+std::string colladaText(const core::TriangleMesh& mesh);
+
 /// A glTF model of the mesh: one buffer (positions as floats, then indices as unsigned ints), one mesh of
 /// one triangle primitive (accessor 0 its positions, 1 its indices), placed by one node in scene 0. Tests
 /// change it (transforms, more nodes, broken accessors) before writing it. Made here, not by io's glTF

@@ -59,7 +59,8 @@ struct MeshFileSize {
 /// file's bytes can hold, so a corrupt count does not pass for a huge mesh), binary STL's triangle count;
 /// OBJ's `v` and `f` lines and ASCII STL's facets counted in one streamed pass, for files over 16 MiB
 /// (smaller ones: zero, not worth a pass); glTF's accessor counts, over the meshes its nodes place (a
-/// mesh placed twice counts twice). Errors: kIo, kUnknownFormat.
+/// mesh placed twice counts twice); FBX and COLLADA: zero (assimp alone parses them, in a worker whose
+/// count loadMesh checks before the mesh is read in). Errors: kIo, kUnknownFormat.
 Result<MeshFileSize> estimateMeshFile(const std::filesystem::path& path);
 
 /// The memory this process can still allocate: the least of the system's available memory
@@ -84,13 +85,16 @@ struct LoadedMesh {
   core::TriangleMesh mesh;
   core::TopologyReport topology;         ///< of `mesh` as returned
   core::MeshDefects defects;             ///< as read, before any face was dropped
-  std::string format;                    ///< "obj", "ply", "off", "stl", "gltf" or "glb"
+  std::string format;                    ///< "obj", "ply", "off", "stl", "gltf", "glb", "fbx" or "dae"
   std::size_t polygonsTriangulated = 0;  ///< faces with more than three vertices, fan-triangulated
-  std::size_t meshInstances = 0;         ///< glTF: meshes the scene's nodes place (0 for other formats)
-  std::size_t primitivesSkipped = 0;     ///< glTF: point and line primitives, skipped
-  std::size_t skinnedInstances = 0;      ///< glTF: skinned meshes, read in their bind pose
-  std::size_t facesDropped = 0;          ///< repeated-vertex faces dropped under allowDegenerateFaces
-  bool flippedInsideOut = false;         ///< wound inward as read, flipped (LoadOptions::orientOutward)
+  std::size_t meshInstances = 0;         ///< glTF, FBX, COLLADA: meshes the scene's nodes place (else 0)
+  std::size_t primitivesSkipped = 0;     ///< glTF, FBX, COLLADA: point and line primitives, skipped
+  /// FBX: the file's unit in metres (its UnitScaleFactor over 100; FBX's default unit is the
+  /// centimetre), applied as it was read, before `scale`; 1 for other formats.
+  double fileUnit = 1.0;
+  std::size_t skinnedInstances = 0;  ///< glTF: skinned meshes, read in their bind pose
+  std::size_t facesDropped = 0;      ///< repeated-vertex faces dropped under allowDegenerateFaces
+  bool flippedInsideOut = false;     ///< wound inward as read, flipped (LoadOptions::orientOutward)
   /// Shells wound inward with no material around them (not cavities: inside-out solids of their own),
   /// turned outward (LoadOptions::orientOutward; surfaces of up to kMaxShellsChecked such shells).
   std::size_t shellsTurnedOutward = 0;
@@ -110,12 +114,15 @@ struct LoadedMesh {
   std::vector<std::string> notes() const;
 };
 
-/// Reads an OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary) or glTF 2.0 (.gltf with its buffers,
-/// or .glb) file, chosen by extension (case-insensitive): OBJ, PLY and OFF by shapedb's own readers
-/// (double precision; of OBJ, only `v` and `f` statements are read, no other file is opened), STL
-/// through OpenMesh's (single precision), glTF through tinygltf: the default scene's meshes placed by
-/// their nodes, in metres, as one surface (see LoadedMesh::meshInstances; a surface split into
-/// primitives is welded along its seams).
+/// Reads an OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf with its buffers,
+/// or .glb), FBX (binary or ASCII) or COLLADA (.dae) file, chosen by extension (case-insensitive): OBJ,
+/// PLY and OFF by shapedb's own readers (double precision; of OBJ, only `v` and `f` statements are read,
+/// no other file is opened), STL through OpenMesh's (single precision), glTF through tinygltf: the
+/// default scene's meshes placed by their nodes, in metres, as one surface (see
+/// LoadedMesh::meshInstances; a surface split into primitives is welded along its seams). FBX and
+/// COLLADA likewise, through assimp in a worker process that a malformed file cannot take this one down
+/// with (single precision; FBX's unit applied, LoadedMesh::fileUnit; assimp turns a COLLADA scene
+/// whose up axis is Z to Y up).
 /// Polygons are fan-triangulated; vertices are kept as the file has them (STL's duplicated corners are
 /// merged by OpenMesh's reader). A file too large for the memory there is, by its header, is refused
 /// before it is read (LoadOptions::memoryBudget). Every error names the file:
@@ -124,8 +131,9 @@ struct LoadedMesh {
 /// Thread-safe.
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options = {});
 
-/// The mesh files (.obj, .ply, .off, .stl, .gltf, .glb, any case) in `directory` and its subdirectories,
-/// sorted by path. Errors: kIo (not a directory, unreadable, or no mesh file in it), naming the directory.
+/// The mesh files (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae, any case) in `directory` and its
+/// subdirectories, sorted by path. Errors: kIo (not a directory, unreadable, or no mesh file in it), naming
+/// the directory.
 Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::path& directory);
 
 /// What saveMesh writes.
