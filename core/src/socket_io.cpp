@@ -1,8 +1,11 @@
 #include <algorithm>
 #include <cerrno>
+#include <fcntl.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/syscall.h>
 #include <sys/types.h>
+#include <unistd.h>
 
 #include <shapedb/core/socket_io.h>
 
@@ -38,6 +41,17 @@ bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline,
     bytes -= static_cast<std::size_t>(n);
   }
   return true;
+}
+
+int isolateWorker(int socket) {
+  const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+  if (devnull >= 0) {
+    ::dup2(devnull, STDOUT_FILENO);
+    ::dup2(devnull, STDERR_FILENO);
+  }
+  ::dup2(socket, 3);
+  ::syscall(SYS_close_range, 4u, ~0u, 0u);
+  return 3;
 }
 
 }  // namespace shapedb::core

@@ -11,11 +11,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <dlfcn.h>
-#include <fcntl.h>
 #include <signal.h>
 #include <string>
 #include <sys/socket.h>
-#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <vector>
@@ -170,15 +168,7 @@ Result<RawPolygons> readWithAssimp(const std::filesystem::path& path,
     return fileError(path, ErrorCode::kIo, std::string("fork: ") + std::strerror(errno));
   }
   if (pid == 0) {
-    // assimp's own output, or a crash report, goes to /dev/null; only the socket and stdio are kept.
-    const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (devnull >= 0) {
-      ::dup2(devnull, STDOUT_FILENO);
-      ::dup2(devnull, STDERR_FILENO);
-    }
-    ::dup2(fds[1], 3);
-    ::syscall(SYS_close_range, 4u, ~0u, 0u);
-    readInWorker(3, file.c_str(), fbx);
+    readInWorker(core::isolateWorker(fds[1]), file.c_str(), fbx);  // assimp's output to /dev/null
   }
   ::close(fds[1]);
   const int fd = fds[0];

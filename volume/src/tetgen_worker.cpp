@@ -7,11 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/socket.h>
-#include <sys/syscall.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -217,19 +215,8 @@ class TetGenWorker {
     }
     if (pid == 0) {
       ::close(fds[0]);
-      // TetGen prints nothing with 'Q'; anything it or a crash report writes goes to /dev/null. The file
-      // descriptors are redirected, not the FILE streams: flushing the inherited stdout would write the
-      // parent's pending output a second time.
-      const int devnull = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-      if (devnull >= 0) {
-        ::dup2(devnull, STDOUT_FILENO);
-        ::dup2(devnull, STDERR_FILENO);
-      }
-      // Keep the socket and stdio only: a descriptor inherited from the parent (another worker's socket,
-      // the database file) must not outlive the parent's own copy, or that worker never sees end of stream.
-      ::dup2(fds[1], 3);
-      ::syscall(SYS_close_range, 4u, ~0u, 0u);
-      serveTetGen(3);
+      // TetGen prints nothing with 'Q'; anything it or a crash report writes goes to /dev/null.
+      serveTetGen(core::isolateWorker(fds[1]));
     }
     ::close(fds[1]);
     mFd = fds[0];

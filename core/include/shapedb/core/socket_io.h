@@ -17,4 +17,11 @@ bool sendAll(int fd, const void* data, std::size_t bytes);
 /// (`timedOut` then true).
 bool receiveAll(int fd, void* data, std::size_t bytes, const Deadline& deadline, bool& timedOut);
 
+/// In a worker process just forked: its stdout and stderr go to /dev/null (whatever the third-party code
+/// or a crash report writes; the descriptors are redirected, not the FILE streams, whose flushing would
+/// write the parent's pending output a second time), and of the descriptors it inherited only stdio and
+/// `socket` are kept, the socket as descriptor 3 (a descriptor of the parent's, another worker's socket or
+/// the database file, must not outlive the parent's own copy). Returns 3.
+int isolateWorker(int socket);
+
 }  // namespace shapedb::core
