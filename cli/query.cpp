@@ -540,7 +540,8 @@ Command addQueryCommand(CLI::App& parent) {
       "Find the database entries most similar to each mesh and give the mesh the best one's physical data\n"
       "(paper Algorithm 1): the entry's tet mesh, modes, collision compound and mass properties carried to\n"
       "the mesh's frame and size and scaled to a material; the mesh's vertices linked to the tets; and a\n"
-      "fidelity report per match (principal moments and surface deviation against the mesh, relative).\n"
+      "fidelity report per match asked for (principal moments and surface deviation against the mesh, "
+      "relative).\n"
       "Meshes must be closed and consistently oriented. Many meshes (the fragments of a fracture, say) are\n"
       "answered together, spread over the machine's cores, and printed in the order given. Exit status 1\n"
       "if any mesh failed.");

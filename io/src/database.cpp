@@ -508,7 +508,12 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
   std::vector<std::shared_ptr<const CachedEntry>> entries;
   const std::size_t candidateCount =
       correcting ? std::min(out.matches.size(), static_cast<std::size_t>(options.correctionCandidates)) : 1;
-  const std::size_t fetchCount = options.fidelity ? out.matches.size() : candidateCount;
+  // The fidelity report covers the matches asked for (and the correction's candidates), not the further
+  // ones a spectrum is blended from: it would fetch their tets.
+  const std::size_t reportCount = std::min(
+      out.matches.size(),
+      static_cast<std::size_t>(std::max(options.search.k, correcting ? options.correctionCandidates : 1)));
+  const std::size_t fetchCount = options.fidelity ? std::max(reportCount, candidateCount) : candidateCount;
   for (std::size_t i = 0; i < fetchCount; ++i) {
     auto e = mImpl->cachedEntry(out.matches[i].match.entry);
     if (!e) return e.error();
@@ -652,6 +657,7 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
     t = Clock::now();
     const core::ClosestPointTree queryTree(mesh);
     for (std::size_t i = 0; i < out.matches.size(); ++i) {
+      if (i >= reportCount && i != out.answered) continue;
       MatchReport& m = out.matches[i];
       const core::Placement placement = core::placementOf(out.normalization, m.match.orientation);
       m.fidelity = core::assessFidelity(mesh, queryTree, out.normalization, entries[i]->locator,

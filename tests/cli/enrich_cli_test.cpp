@@ -105,8 +105,8 @@ TEST(EnrichCli, QueryEnrichAnswersTwiceAndTheSecondAnswerIsTheLearnedEntry) {
   EXPECT_LT(again["matches"][0]["distance"].get<double>(), 1e-9);
   EXPECT_NE(again["physics"]["frequencies_hz"][0], q["physics"]["frequencies_hz"][0]);
   EXPECT_GT(q["predicted_frequency_error"].get<double>(), 0.0);
-  for (const auto& m : q["matches"])  // and each match its own
-    EXPECT_GT(m["predicted_frequency_error"].get<double>(), 0.0) << m.dump();
+  // and the match asked for its own (the neighbours blended beside it have no fidelity report)
+  EXPECT_GT(q["matches"][0]["predicted_frequency_error"].get<double>(), 0.0) << q["matches"][0].dump();
   EXPECT_LT(again["matches"][0]["predicted_frequency_error"].get<double>(),
             q["matches"][0]["predicted_frequency_error"].get<double>())
       << "the object's own learned entry is predicted closer than the entry it matched before";

@@ -299,6 +299,16 @@ TEST_F(SmallDatabase, TheNearestTiersEigenvaluesBlendTheNearestMatchesSpectra) {
   std::printf("%zu of %zu queries blended\n", blendedQueries, db->entries().size());
   EXPECT_GT(blendedQueries, 0u);
 
+  // The fidelity report covers the match asked for, not the neighbours blended beside it.
+  QueryOptions reported;
+  auto withFidelity = db->query(core::makeBox({1.0, 2.0, 3.0}), reported);
+  ASSERT_TRUE(withFidelity.ok()) << withFidelity.error().message;
+  ASSERT_EQ(withFidelity->matches.size(), 3u);
+  EXPECT_TRUE(withFidelity->matches[0].fidelity.has_value());
+  EXPECT_FALSE(withFidelity->matches[1].fidelity.has_value());
+  EXPECT_FALSE(withFidelity->matches[2].fidelity.has_value());
+  EXPECT_TRUE(withFidelity->predictedFrequencyError.has_value());
+
   QueryOptions bad;
   bad.neighbours = 0;
   auto refused = db->query(core::makeBox({1.0, 2.0, 3.0}), bad);
@@ -345,12 +355,15 @@ TEST_F(SmallDatabase, AnEntryUnderASimilarityComesBackAsItselfAdaptedToTheQuerys
     EXPECT_LT(f.maxDeviation, sampled ? 1e-2 : 1e-6)
         << e.name << ": the placed tets' boundary is the query's surface";
     EXPECT_GT(r->matches[1].fidelity->meanDeviation, f.meanDeviation) << e.name;
-    // Every match's own estimate, from its fidelity report: the worse match is predicted worse.
-    for (const MatchReport& m : r->matches) {
+    // Every match asked for has its own estimate, from its fidelity report: the worse match is predicted
+    // worse. The third, found for the answer's spectrum, has neither.
+    for (std::size_t asked = 0; asked < 2; ++asked) {
+      const MatchReport& m = r->matches[asked];
       ASSERT_TRUE(m.predictedFrequencyError) << e.name;
       EXPECT_DOUBLE_EQ(*m.predictedFrequencyError,
                        core::predictFrequencyError(core::evidenceOf(*m.fidelity)));
     }
+    EXPECT_FALSE(r->matches[2].fidelity.has_value()) << e.name;
     EXPECT_GT(*r->matches[1].predictedFrequencyError, *r->matches[0].predictedFrequencyError) << e.name;
 
     // Scaling laws against the query's own size L and the material.

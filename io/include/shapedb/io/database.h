@@ -85,7 +85,10 @@ struct QueryOptions {
   /// follows the search's k best in QueryResult::matches (a shape-alone match's distance has no moment
   /// term). Up to four more morphs, on those queries only.
   bool correctionFallback = true;
-  bool fidelity = true;  ///< a fidelity report for every match (fetches each match's tet mesh)
+  /// A fidelity report for each of the first search.k matches (with correct, at least the candidates) and
+  /// the answered one; the further matches a spectrum is blended from (neighbours) get none. Fetches each
+  /// reported match's tet mesh.
+  bool fidelity = true;
   core::FidelityOptions fidelityOptions;
 };
 
@@ -220,7 +223,7 @@ class Database {
                                          const core::SearchOptions& search = {}) const;
 
   /// Algorithm 1 of the paper, whole: match `mesh` (any frame, any size; closed and oriented), then
-  /// fetch, adapt and link the best match and report the fidelity of every match. Thread-safe: many
+  /// fetch, adapt and link the best match and report the fidelity of the matches asked for. Thread-safe: many
   /// threads may query at once (each keeps its own descriptor scratch).
   /// Errors: the mesh's (validateMesh, computeMassProperties: open or degenerate surfaces), the
   /// material's, Store::physics's.
