@@ -1,9 +1,13 @@
 // FBX and COLLADA files, read through assimp in a worker process (io/src/assimp_reader.h): files written
 // here by hand, as the formats define them, and read back through loadMesh.
+#include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -108,6 +112,103 @@ Connections:  {
 )";
 }
 
+/// A binary FBX file (version 7400) of the same two cubes as fbxCubes, written record by record as the
+/// format lays them out: each node its end offset, property count and bytes, name, properties (typed:
+/// I int32, L int64, D double, S string, d and i uncompressed arrays) and children, closed by a 13-byte
+/// null record.
+class BinaryFbx {
+ public:
+  struct Node {
+    std::string name;
+    std::string properties;  ///< encoded
+    std::size_t count = 0;   ///< properties
+    std::vector<Node> children;
+  };
+  static void add(Node& n, std::int32_t v) { n.properties += 'I' + raw(v), ++n.count; }
+  static void add(Node& n, std::int64_t v) { n.properties += 'L' + raw(v), ++n.count; }
+  static void add(Node& n, double v) { n.properties += 'D' + raw(v), ++n.count; }
+  static void add(Node& n, const std::string& v) {
+    n.properties += 'S' + raw(static_cast<std::uint32_t>(v.size())) + v, ++n.count;
+  }
+  template <typename T>
+  static void add(Node& n, const std::vector<T>& v) {
+    std::string bytes;
+    for (const T& x : v)
+      bytes += raw(x);
+    n.properties += (std::is_same_v<T, double> ? 'd' : 'i') + raw(static_cast<std::uint32_t>(v.size())) +
+                    raw(std::uint32_t{0}) + raw(static_cast<std::uint32_t>(bytes.size())) + bytes;
+    ++n.count;
+  }
+  static std::string file(const std::vector<Node>& top) {
+    std::string out = std::string("Kaydara FBX Binary  \0\x1a\0", 23) + raw(std::uint32_t{7400});
+    for (const Node& n : top)
+      out += record(n, out.size());
+    return out + std::string(13, '\0');
+  }
+
+ private:
+  template <typename T>
+  static std::string raw(T v) {
+    return std::string(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  static std::string record(const Node& n, std::size_t offset) {
+    std::string children;
+    const std::size_t head = 13 + n.name.size() + n.properties.size();
+    for (const Node& c : n.children)
+      children += record(c, offset + head + children.size());
+    if (!n.children.empty()) children += std::string(13, '\0');
+    return raw(static_cast<std::uint32_t>(offset + head + children.size())) +
+           raw(static_cast<std::uint32_t>(n.count)) + raw(static_cast<std::uint32_t>(n.properties.size())) +
+           static_cast<char>(n.name.size()) + n.name + n.properties + children;
+  }
+};
+
+std::string binaryFbxCubes(double unitScaleFactor) {
+  using N = BinaryFbx::Node;
+  const auto leaf = [](const std::string& name, auto... values) {
+    N n{name, "", 0, {}};
+    (BinaryFbx::add(n, values), ...);
+    return n;
+  };
+  const auto placed = [&](std::int64_t id, const std::string& name, double tx,
+                          const std::array<double, 3>& s) {
+    N model = leaf("Model", id, std::string("Model::") + name, std::string("Mesh"));
+    N properties{"Properties70", "", 0, {}};
+    properties.children.push_back(leaf("P", std::string("Lcl Translation"), std::string("Lcl Translation"),
+                                       std::string(""), std::string("A"), tx, 0.0, 0.0));
+    properties.children.push_back(leaf("P", std::string("Lcl Scaling"), std::string("Lcl Scaling"),
+                                       std::string(""), std::string("A"), s[0], s[1], s[2]));
+    model.children = {leaf("Version", std::int32_t{232}), properties};
+    return model;
+  };
+  N header{"FBXHeaderExtension",
+           "",
+           0,
+           {leaf("FBXHeaderVersion", std::int32_t{1003}), leaf("FBXVersion", std::int32_t{7400})}};
+  N units{"Properties70",
+          "",
+          0,
+          {leaf("P", std::string("UnitScaleFactor"), std::string("double"), std::string("Number"),
+                std::string(""), unitScaleFactor)}};
+  N settings{"GlobalSettings", "", 0, {leaf("Version", std::int32_t{1000}), units}};
+  N geometry = leaf("Geometry", std::int64_t{100}, std::string("Geometry::cube"), std::string("Mesh"));
+  geometry.children = {
+      leaf("Vertices",
+           std::vector<double>{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1}),
+      leaf("PolygonVertexIndex", std::vector<std::int32_t>{0, 3, 2, -2, 4, 5, 6, -8, 0, 1, 5, -5,
+                                                           1, 2, 6, -6, 2, 3, 7, -7, 3, 0, 4, -8})};
+  N objects{
+      "Objects",
+      "",
+      0,
+      {geometry, placed(200, "stretched", 10.0, {2, 3, 4}), placed(300, "mirrored", -10.0, {-1, 1, 1})}};
+  const auto link = [&](std::int64_t child, std::int64_t parent) {
+    return leaf("C", std::string("OO"), child, parent);
+  };
+  N connections{"Connections", "", 0, {link(200, 0), link(100, 200), link(300, 0), link(100, 300)}};
+  return BinaryFbx::file({header, settings, objects, connections});
+}
+
 /// Checks what both files hold, in units of `unit` metres: two closed solids facing out (the mirrored
 /// cube rewound), 2·3·4 + 1 cubic units, the stretched one's corners where its node put them.
 void expectTwoCubes(const LoadedMesh& loaded, double unit) {
@@ -150,6 +251,12 @@ TEST(Assimp, FbxNodesPlaceTheirMeshesAndItsUnitIsApplied) {
   for (const std::string& note : loaded.notes())
     said = said || note.find("unit is 0.0254 m") != std::string::npos;
   EXPECT_TRUE(said) << "the unit goes unsaid";
+  // The binary form, as modelling tools write it.
+  const auto binary = dir / "binary.fbx";
+  test::writeFile(binary, binaryFbxCubes(2.54));
+  const LoadedMesh fromBinary = mustLoad(binary);
+  EXPECT_NEAR(fromBinary.fileUnit, 0.0254, 1e-9);
+  expectTwoCubes(fromBinary, 0.0254);
   // FBX's default unit, the centimetre, and a scale of the caller's on top of it.
   const auto centimetres = dir / "cm.fbx";
   test::writeFile(centimetres, fbxCubes(1.0));
@@ -172,6 +279,11 @@ TEST(Assimp, MalformedFilesAreErrorsThatNameThem) {
   const auto cut = dir / "cut.dae";
   test::writeFile(cut, whole.substr(0, whole.size() / 2));
   EXPECT_EQ(mustFail(cut).code, ErrorCode::kParse);
+  // A binary FBX cut short: its records' end offsets point past the end.
+  const std::string fbx = binaryFbxCubes(1.0);
+  const auto cutFbx = dir / "cut.fbx";
+  test::writeFile(cutFbx, fbx.substr(0, fbx.size() / 2));
+  EXPECT_EQ(mustFail(cutFbx).code, ErrorCode::kParse);
   // A scene without geometry.
   std::string none = whole;
   const std::size_t from = none.find("<library_geometries>");
