@@ -36,6 +36,17 @@ bool finiteAtLeast(double v, double low) {
   return std::isfinite(v) && v >= low;
 }
 
+/// The head of an encoded ModalData: its Poisson ratio and rigid eigenvalues into `modes`, its shapes'
+/// rows and its mode count; false where they are not what encodeModes writes (or the blob cannot hold
+/// `count` modes of `rows` values).
+bool readModesHead(ByteReader& r, core::ModalData& modes, std::uint32_t& rows, std::uint32_t& count) {
+  if (!(r.get(modes.poissonRatio) && r.get(rows) && r.get(count))) return false;
+  for (double& v : modes.rigidEigenvalues)
+    if (!r.get(v) || !std::isfinite(v)) return false;
+  return r.has(count, 16 + 2 * std::size_t{rows}) && rows % 3 == 0 &&
+         core::validPoissonRatio(modes.poissonRatio);
+}
+
 }  // namespace
 
 std::uint32_t checksum(const void* data, std::size_t size) {
@@ -157,12 +168,7 @@ Result<core::ModalData> decodeModes(const void* data, std::size_t size) {
   ByteReader r(data, size);
   core::ModalData modes;
   std::uint32_t rows = 0, count = 0;
-  if (!(r.get(modes.poissonRatio) && r.get(rows) && r.get(count))) return corrupted("modes");
-  for (double& v : modes.rigidEigenvalues)
-    if (!r.get(v) || !std::isfinite(v)) return corrupted("modes");
-  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0 ||
-      !core::validPoissonRatio(modes.poissonRatio))
-    return corrupted("modes");
+  if (!readModesHead(r, modes, rows, count)) return corrupted("modes");
   modes.eigenvalues.resize(count);
   modes.shapes.resize(rows, count);
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -185,15 +191,9 @@ Result<core::ModalData> decodeModes(const void* data, std::size_t size) {
 
 Result<Eigen::VectorXd> decodeEigenvalues(const void* data, std::size_t size) {
   ByteReader r(data, size);
-  double poissonRatio = 0.0;
+  core::ModalData head;
   std::uint32_t rows = 0, count = 0;
-  if (!(r.get(poissonRatio) && r.get(rows) && r.get(count))) return corrupted("modes");
-  for (std::size_t i = 0; i < std::tuple_size_v<decltype(core::ModalData::rigidEigenvalues)>; ++i) {
-    double rigid = 0.0;
-    if (!r.get(rigid) || !std::isfinite(rigid)) return corrupted("modes");
-  }
-  if (!r.has(count, 16 + 2 * std::size_t{rows}) || rows % 3 != 0 || !core::validPoissonRatio(poissonRatio))
-    return corrupted("modes");
+  if (!readModesHead(r, head, rows, count)) return corrupted("modes");
   Eigen::VectorXd eigenvalues(count);
   for (std::uint32_t i = 0; i < count; ++i) {
     double scale = 0.0;
