@@ -1,6 +1,5 @@
 #include "assimp_reader.h"
 
-#include <array>
 #include <assimp/cimport.h>
 #include <assimp/metadata.h>
 #include <assimp/postprocess.h>
@@ -50,17 +49,12 @@ struct ReplyHeader {
 /// A node of the scene with the transform from it to the scene's frame.
 struct Placed {
   const aiNode* node;
-  std::array<double, 16> transform;  ///< row-major 4 × 4
+  core::Mat4 transform;
 };
 
-std::array<double, 16> times(const std::array<double, 16>& a, const aiMatrix4x4& b) {
-  const double m[16] = {b.a1, b.a2, b.a3, b.a4, b.b1, b.b2, b.b3, b.b4,
-                        b.c1, b.c2, b.c3, b.c4, b.d1, b.d2, b.d3, b.d4};
-  std::array<double, 16> out{};
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      for (int k = 0; k < 4; ++k)
-        out[static_cast<std::size_t>(4 * r + c)] += a[static_cast<std::size_t>(4 * r + k)] * m[4 * k + c];
+core::Mat4 toMat4(const aiMatrix4x4& m) {
+  core::Mat4 out;
+  out << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
   return out;
 }
 
@@ -95,17 +89,16 @@ std::array<double, 16> times(const std::array<double, 16>& a, const aiMatrix4x4&
   }
   // Every mesh each node places, through the transforms down the hierarchy (a tree: assimp makes it one).
   constexpr std::uint64_t kLimit = std::uint64_t{1} << 31;  // indices are 32-bit
-  std::vector<double> vertices;
+  std::vector<core::Vec3> vertices;
   std::vector<std::uint32_t> triangles;
-  std::vector<Placed> stack{{scene->mRootNode, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}};
+  std::vector<Placed> stack{{scene->mRootNode, core::Mat4::Identity()}};
   while (!stack.empty()) {
     const Placed here = stack.back();
     stack.pop_back();
-    const std::array<double, 16> t = times(here.transform, here.node->mTransformation);
+    const core::Mat4 t = here.transform * toMat4(here.node->mTransformation);
     for (unsigned c = 0; c < here.node->mNumChildren; ++c)
       stack.push_back({here.node->mChildren[c], t});
-    const double det = t[0] * (t[5] * t[10] - t[6] * t[9]) - t[1] * (t[4] * t[10] - t[6] * t[8]) +
-                       t[2] * (t[4] * t[9] - t[5] * t[8]);
+    const double det = t.topLeftCorner<3, 3>().determinant();
     for (unsigned k = 0; k < here.node->mNumMeshes; ++k) {
       const unsigned index = here.node->mMeshes[k];
       if (index >= scene->mNumMeshes) continue;
@@ -114,16 +107,12 @@ std::array<double, 16> times(const std::array<double, 16>& a, const aiMatrix4x4&
         ++h.skipped;  // points or lines: no surface
         continue;
       }
-      const std::uint64_t first = vertices.size() / 3;
+      const std::uint64_t first = vertices.size();
       if (first + mesh->mNumVertices >= kLimit || triangles.size() / 3 + mesh->mNumFaces >= kLimit)
         replyFailure(fd, ReplyHeader::kTooMany, "more than 2^31 vertices or triangles");
       for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
         const aiVector3D& p = mesh->mVertices[v];
-        for (int r = 0; r < 3; ++r)
-          vertices.push_back(
-              h.unit *
-              (t[static_cast<std::size_t>(4 * r)] * p.x + t[static_cast<std::size_t>(4 * r + 1)] * p.y +
-               t[static_cast<std::size_t>(4 * r + 2)] * p.z + t[static_cast<std::size_t>(4 * r + 3)]));
+        vertices.push_back(h.unit * core::transformPoint(t, core::Vec3(p.x, p.y, p.z)));
       }
       for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
         const aiFace& face = mesh->mFaces[f];
@@ -141,9 +130,10 @@ std::array<double, 16> times(const std::array<double, 16>& a, const aiMatrix4x4&
       ++h.meshInstances;
     }
   }
-  h.vertices = vertices.size() / 3;
+  h.vertices = vertices.size();
   h.triangles = triangles.size() / 3;
-  if (core::sendAll(fd, &h, sizeof h) && core::sendAll(fd, vertices.data(), vertices.size() * sizeof(double)))
+  if (core::sendAll(fd, &h, sizeof h) &&
+      core::sendAll(fd, vertices.data(), vertices.size() * sizeof(core::Vec3)))
     core::sendAll(fd, triangles.data(), triangles.size() * sizeof(std::uint32_t));
   ::_exit(0);
 }
@@ -194,12 +184,10 @@ Result<RawPolygons> readWithAssimp(const std::filesystem::path& path,
     } else if (h.vertices < (std::uint64_t{1} << 31) && h.triangles < (std::uint64_t{1} << 31)) {
       raw.vertices.resize(h.vertices);
       raw.corners.resize(3 * h.triangles);
-      std::vector<double> xyz(3 * h.vertices);
-      received = core::receiveAll(fd, xyz.data(), xyz.size() * sizeof(double), deadline, timedOut) &&
+      received = core::receiveAll(fd, raw.vertices.data(), raw.vertices.size() * sizeof(core::Vec3), deadline,
+                                  timedOut) &&
                  core::receiveAll(fd, raw.corners.data(), raw.corners.size() * sizeof(std::uint32_t),
                                   deadline, timedOut);
-      for (std::size_t i = 0; i < raw.vertices.size(); ++i)
-        raw.vertices[i] = core::Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
       raw.ends.resize(h.triangles);
       for (std::size_t f = 0; f < raw.ends.size(); ++f)
         raw.ends[f] = 3 * (f + 1);
