@@ -347,7 +347,12 @@ ClosestPointTree::Hit ClosestPointTree::search(const Vec3& p, Hit best, double b
     if (pending.key >= bestSq) continue;
     if (pending.count > 0) {
       for (std::uint32_t i = pending.child; i < pending.child + pending.count; ++i) {
-        const TrianglePoint q = closestOnTriangle(p, i);
+        const auto& t = mTriangles[i];
+        const Vec3 &a = mVertices[t[0]], &b = mVertices[t[1]], &c = mVertices[t[2]];
+        const Vec3 gap =
+            (a.cwiseMin(b).cwiseMin(c) - p).cwiseMax(p - a.cwiseMax(b).cwiseMax(c)).cwiseMax(0.0);
+        if (gap.squaredNorm() >= bestSq) continue;
+        const TrianglePoint q = closestPointOnTriangle(p, a, b, c);
         if (q.squaredDistance < bestSq) {
           bestSq = q.squaredDistance;
           best = {mOrder[i], q};
@@ -428,7 +433,7 @@ std::optional<RayHit> ClosestPointTree::firstHit(const Vec3& origin, const Vec3&
 
 TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tets) {
   const std::size_t n = mTets.size();
-  mInverse.resize(n);
+  mToWeights.resize(n);
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Vec3& x : mNodes) {
     lo = lo.cwiseMin(x);
@@ -438,7 +443,8 @@ TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tet
     const auto& k = mTets[t];
     Mat3 edges;
     edges << mNodes[k[1]] - mNodes[k[0]], mNodes[k[2]] - mNodes[k[0]], mNodes[k[3]] - mNodes[k[0]];
-    mInverse[t] = edges.inverse();
+    const Mat3 inverse = edges.inverse();
+    mToWeights[t] << inverse, -(inverse * mNodes[k[0]]);
   }
 
   // About two cells per tet, shaped like the bounding box.
@@ -492,7 +498,8 @@ TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tet
 }
 
 std::array<double, 4> TetLocator::weightsIn(std::uint32_t t, const Vec3& p) const {
-  const Vec3 l = mInverse[t] * (p - mNodes[mTets[t][0]]);
+  const Eigen::Matrix<double, 3, 4>& m = mToWeights[t];
+  const Vec3 l = m.leftCols<3>() * p + m.col(3);
   return {1.0 - l.sum(), l[0], l[1], l[2]};
 }
 
@@ -532,6 +539,12 @@ TetLocation TetLocator::locate(const Vec3& p, Hint* hint) const {
     if (!(u >= 0.0 && u <= mDims[a])) return outside(p, hint);  // also NaN
     c[a] = std::min(static_cast<int>(u), mDims[a] - 1);
   }
+  // Well inside one tet: the tets of a conforming mesh do not overlap, so no other holds p. The tet that
+  // held the last point is tried first: the next point on a surface is often in it too.
+  if (hint && hint->tet < mTets.size()) {
+    const auto w = weightsIn(hint->tet, p);
+    if (minWeight(w) > kClearlyInside) return {hint->tet, w, 0.0};
+  }
   const std::size_t cell = (static_cast<std::size_t>(c[2]) * mDims[1] + c[1]) * mDims[0] + c[0];
   double bestMin = -std::numeric_limits<double>::infinity();
   TetLocation best;
@@ -542,11 +555,13 @@ TetLocation TetLocator::locate(const Vec3& p, Hint* hint) const {
     if (m > bestMin || (m == bestMin && t < best.tet)) {
       bestMin = m;
       best = {t, w, 0.0};
-      // Well inside one tet: the tets of a conforming mesh do not overlap, so no other holds p.
-      if (m > kClearlyInside) return best;
+      if (m > kClearlyInside) break;
     }
   }
-  if (bestMin >= -kInsideTolerance) return best;
+  if (bestMin >= -kInsideTolerance) {
+    if (hint) hint->tet = best.tet;
+    return best;
+  }
   return outside(p, hint);
 }
 

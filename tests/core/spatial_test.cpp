@@ -276,6 +276,43 @@ TEST(TetLocator, AgreesWithBruteForceInsideAndOutside) {
   EXPECT_LT(inside, 2000);
 }
 
+// A hint carries the last point's tet and boundary face: along a walk of small steps, in and out of the
+// mesh and across its tets' faces, as a surface's vertices follow each other, every answer is still
+// brute force's.
+TEST(TetLocator, AHintAlongAWalkAgreesWithBruteForce) {
+  std::mt19937_64 rng(13);
+  const TetMesh mesh = test::makeTetGrid(6, 4, 3, 0.3, rng);
+  const TetLocator locator(mesh);
+  std::normal_distribution<double> step(0.0, 0.12);
+  TetLocator::Hint hint;
+  Vec3 p(3.0, 2.0, 1.5);
+  int inside = 0, staysInTet = 0;
+  std::uint32_t lastTet = std::numeric_limits<std::uint32_t>::max();
+  for (int i = 0; i < 6000; ++i) {
+    p += Vec3(step(rng), step(rng), step(rng));
+    // Drawn back towards the middle, so that the walk crosses the boundary both ways many times.
+    p += 0.002 * (Vec3(3.0, 2.0, 1.5) - p);
+    const TetLocation fast = locator.locate(p, hint);
+    const TetLocation slow = locateBruteForce(locator, p);
+    ASSERT_EQ(fast.inside(), slow.inside()) << "step " << i;
+    if (fast.inside()) {
+      ++inside;
+      staysInTet += fast.tet == lastTet;
+      lastTet = fast.tet;
+      ASSERT_EQ(fast.tet, slow.tet) << "step " << i;
+      for (std::size_t k = 0; k < 4; ++k)
+        ASSERT_EQ(fast.weights[k], slow.weights[k]) << "step " << i;
+    } else {
+      ASSERT_NEAR(fast.distance, slow.distance, 1e-12) << "step " << i;
+      ASSERT_LT((test::interpolate(mesh, fast) - test::interpolate(mesh, slow)).norm(), 1e-9);
+    }
+  }
+  // Both sides, and many steps that stay in the tet of the step before (the hint's case).
+  EXPECT_GT(inside, 1000);
+  EXPECT_LT(inside, 5000);
+  EXPECT_GT(staysInTet, 300);
+}
+
 // boundaryFaces (a counting sort by smallest node) against faces counted in a map: the same faces, the
 // same winding and owner, in the order of their sorted nodes. Random tets are taken out of a jittered grid,
 // which leaves inner cavities and faces that two removed tets shared, and the nodes are renumbered at

@@ -164,6 +164,7 @@ class TetLocator {
   /// on a surface are close, and so are their closest boundary faces. One per thread.
   struct Hint {
     std::uint32_t face = std::numeric_limits<std::uint32_t>::max();
+    std::uint32_t tet = std::numeric_limits<std::uint32_t>::max();  ///< the last tet a point was inside
   };
   /// The same answer as locate(p), faster for a sequence of nearby points (outside the mesh, the
   /// closest point may be reported in another of the faces sharing it).
@@ -184,7 +185,9 @@ class TetLocator {
 
   std::vector<Vec3> mNodes;
   std::vector<TetMesh::Tet> mTets;
-  std::vector<Mat3> mInverse;  ///< per tet: inverse of [b − a, c − a, d − a]
+  /// Per tet: its barycentric coordinates λ₁, λ₂, λ₃ as an affine map of the point, [B⁻¹ | −B⁻¹ a] with
+  /// B = [b − a, c − a, d − a], so that testing a tet reads one record.
+  std::vector<Eigen::Matrix<double, 3, 4>> mToWeights;
   Vec3 mOrigin = Vec3::Zero();
   Vec3 mInvCell = Vec3::Zero();
   std::array<int, 3> mDims{};
