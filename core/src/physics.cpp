@@ -97,35 +97,52 @@ MassProperties computeTetMassProperties(const TetMesh& mesh, double density) {
 
 std::vector<BoundaryFace> boundaryFaces(const TetMesh& mesh) {
   // A face seen by one tet only is on the boundary. Faces of a positively oriented tet (a, b, c, d),
-  // wound outward: (a, c, b), (a, b, d), (b, c, d), (a, d, c). The faces are counting-sorted by their
-  // smallest node, and each node's few faces sorted by the other two (ties by tet, so that the order is
-  // fixed): an inner face is two equal keys in a row. One pass over the faces where one sort of all of
-  // them took O(F log F): a locator is built for every entry a query fetches.
+  // wound outward: (a, c, b), (a, b, d), (b, c, d), (a, d, c), each across from one corner. The faces are
+  // counting-sorted by their smallest node, and each node's few faces sorted by the other two (ties by
+  // tet, so that the order is fixed): an inner face is two equal keys in a row. One pass over the faces
+  // where one sort of all of them took O(F log F): a locator is built for every entry a query fetches.
+  // A face's sorted nodes are its tet's sorted nodes less the corner across from it, so a tet's four
+  // nodes are sorted once.
   std::uint32_t nodes = 0;
   for (const TetMesh::Tet& tet : mesh.tets)
     for (const std::uint32_t v : tet)
       nodes = std::max(nodes, v + 1);
   struct Keyed {
-    std::uint32_t second, third;  // the face's sorted nodes after its smallest
+    std::uint32_t first, second, third;  // the face's nodes, sorted
     BoundaryFace face;
   };
-  const auto each = [&mesh](auto&& visit) {
-    for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
-      const auto& [a, b, c, d] = mesh.tets[t];
-      for (const std::array<std::uint32_t, 3>& f :
-           {std::array{a, c, b}, std::array{a, b, d}, std::array{b, c, d}, std::array{a, d, c}}) {
-        std::array<std::uint32_t, 3> key = f;
-        std::sort(key.begin(), key.end());
-        visit(key, BoundaryFace{f, t});
-      }
-    }
-  };
+  std::vector<Keyed> keyed(4 * mesh.tets.size());
   std::vector<std::uint32_t> begin(static_cast<std::size_t>(nodes) + 1, 0);
-  each([&](const auto& key, const BoundaryFace&) { ++begin[key[0] + 1]; });
+  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t) {
+    const auto& [a, b, c, d] = mesh.tets[t];
+    std::array<std::uint32_t, 4> sorted{a, b, c, d};
+    std::sort(sorted.begin(), sorted.end());
+    const std::array<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>, 4> faces{
+        {{{a, c, b}, d}, {{a, b, d}, c}, {{b, c, d}, a}, {{a, d, c}, b}}};
+    for (std::size_t f = 0; f < 4; ++f) {
+      const auto& [nodesOf, across] = faces[f];
+      // The tet's sorted nodes less one occurrence of the corner across: the face's own, sorted.
+      std::array<std::uint32_t, 3> key{};
+      bool skipped = false;
+      for (std::size_t i = 0, k = 0; i < 4; ++i) {
+        if (!skipped && sorted[i] == across) {
+          skipped = true;
+          continue;
+        }
+        key[k++] = sorted[i];
+      }
+      Keyed& out = keyed[4 * t + f];
+      out = {key[0], key[1], key[2], BoundaryFace{nodesOf, t}};
+      ++begin[key[0] + 1];
+    }
+  }
   std::partial_sum(begin.begin(), begin.end(), begin.begin());
-  std::vector<Keyed> faces(4 * mesh.tets.size());
-  std::vector<std::uint32_t> next(begin.begin(), begin.end() - 1);
-  each([&](const auto& key, const BoundaryFace& face) { faces[next[key[0]]++] = {key[1], key[2], face}; });
+  std::vector<Keyed> faces(keyed.size());
+  {
+    std::vector<std::uint32_t> next(begin.begin(), begin.end() - 1);
+    for (const Keyed& k : keyed)
+      faces[next[k.first]++] = k;
+  }
 
   std::vector<BoundaryFace> out;
   for (std::uint32_t v = 0; v < nodes; ++v) {
