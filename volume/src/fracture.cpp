@@ -30,6 +30,36 @@ using detail::Meshing;
 
 constexpr double kFrameMargin = 16.0;  ///< voxels between the local frame's origin and the mesh's bounds
 
+/// A level set's crossing can close a speck apart from the fragment around it (where the solid is a
+/// voxel thin): a shell of its own, a crumb by volume. Such shells are dropped and counted as the crumbs
+/// they are, so that each fragment is its solid alone; a fragment whose every solid shell is a crumb is
+/// left whole, to be counted as one crumb. Cavities stay.
+void dropCrumbShells(TriangleMesh& piece, double crumbVolume, FractureResult& result) {
+  const std::vector<core::Shell> shells = core::findShells(piece);
+  if (shells.size() < 2) return;
+  const auto isCrumb = [crumbVolume](const core::Shell& s) {
+    return !s.cavity && std::abs(s.volume) < crumbVolume;
+  };
+  if (std::all_of(shells.begin(), shells.end(), [&](const core::Shell& s) { return s.cavity || isCrumb(s); }))
+    return;
+  std::vector<bool> dropped(piece.triangles.size(), false);
+  bool any = false;
+  for (const core::Shell& s : shells) {
+    if (!isCrumb(s)) continue;
+    any = true;
+    ++result.crumbsDropped;
+    result.droppedVolume += std::abs(s.volume);
+    for (const std::uint32_t t : s.triangles)
+      dropped[t] = true;
+  }
+  if (!any) return;
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < piece.triangles.size(); ++t)
+    if (!dropped[t]) piece.triangles[kept++] = piece.triangles[t];
+  piece.triangles.resize(kept);
+  core::removeUnusedVertices(piece);
+}
+
 }  // namespace
 
 std::string fragmentName(std::size_t index) {
@@ -148,6 +178,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   std::vector<std::pair<double, TriangleMesh>> pieces;
   for (auto& [piece, meshing] : surfaces) {
     if (piece.triangles.empty()) continue;
+    dropCrumbShells(piece, options.minVolumeFraction * volume, result);
     const double v = core::computeSignedVolume(piece);
     if (meshing == Meshing::kOpen) {
       // No crossing near the zero level closed: never seen, and not passed on as a solid.

@@ -40,7 +40,9 @@ struct FractureResult {
   double solidVolume = 0.0;                   ///< the mesh's enclosed volume (m³)
   double keptVolume = 0.0;                    ///< the fragments' total volume (m³)
   double droppedVolume = 0.0;                 ///< the dropped pieces' total volume (m³)
-  std::size_t crumbsDropped = 0;              ///< fragments under minVolumeFraction
+  /// Pieces under minVolumeFraction: fragments, and specks the level set closed apart from a fragment
+  /// (a shell of their own beside it, where the solid is a voxel thin), which are dropped from it.
+  std::size_t crumbsDropped = 0;
   /// Fragments whose zero crossing was not a closed manifold surface and that were meshed again a
   /// hundredth of a voxel (or a few) off the zero level, where it was.
   std::size_t remeshed = 0;
