@@ -443,8 +443,7 @@ TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tet
     const auto& k = mTets[t];
     Mat3 edges;
     edges << mNodes[k[1]] - mNodes[k[0]], mNodes[k[2]] - mNodes[k[0]], mNodes[k[3]] - mNodes[k[0]];
-    const Mat3 inverse = edges.inverse();
-    mToWeights[t] << inverse, -(inverse * mNodes[k[0]]);
+    mToWeights[t] << edges.inverse(), mNodes[k[0]];
   }
 
   // About two cells per tet, shaped like the bounding box.
@@ -499,7 +498,7 @@ TetLocator::TetLocator(const TetMesh& mesh) : mNodes(mesh.nodes), mTets(mesh.tet
 
 std::array<double, 4> TetLocator::weightsIn(std::uint32_t t, const Vec3& p) const {
   const Eigen::Matrix<double, 3, 4>& m = mToWeights[t];
-  const Vec3 l = m.leftCols<3>() * p + m.col(3);
+  const Vec3 l = m.leftCols<3>() * (p - m.col(3));
   return {1.0 - l.sum(), l[0], l[1], l[2]};
 }
 

@@ -185,8 +185,8 @@ class TetLocator {
 
   std::vector<Vec3> mNodes;
   std::vector<TetMesh::Tet> mTets;
-  /// Per tet: its barycentric coordinates λ₁, λ₂, λ₃ as an affine map of the point, [B⁻¹ | −B⁻¹ a] with
-  /// B = [b − a, c − a, d − a], so that testing a tet reads one record.
+  /// Per tet: [B⁻¹ | a], B = [b − a, c − a, d − a], its barycentric coordinates λ₁, λ₂, λ₃ = B⁻¹ (p − a)
+  /// from one record. (p − a first: exact enough wherever the mesh sits, far from the origin too.)
   std::vector<Eigen::Matrix<double, 3, 4>> mToWeights;
   Vec3 mOrigin = Vec3::Zero();
   Vec3 mInvCell = Vec3::Zero();
