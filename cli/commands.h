@@ -4,6 +4,8 @@
 
 #include <functional>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -77,5 +79,11 @@ void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags);
 /// Every command that reads a mesh file reads it through this.
 Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags = {},
                                     std::optional<volume::RepairReport>* repaired = nullptr);
+
+/// The same, with the lines it would print on stderr appended to `messages` instead, in order: for
+/// files loaded side by side whose messages are printed afterwards in the files' order.
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags,
+                                    std::optional<volume::RepairReport>* repaired,
+                                    std::vector<std::string>& messages);
 
 }  // namespace shapedb::cli

@@ -1,6 +1,8 @@
 #include "mesh_input.h"
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "commands.h"
 
@@ -61,11 +63,13 @@ void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
 }
 
 Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags,
-                                    std::optional<volume::RepairReport>* repaired) {
+                                    std::optional<volume::RepairReport>* repaired,
+                                    std::vector<std::string>& messages) {
   Result<io::LoadedMesh> loaded = io::loadMesh(path, flags.options);
   if (!loaded) return loaded;
   for (const std::string& note : loaded->notes())
-    std::fprintf(stderr, "shapedb: warning: %s: %s\n", path.c_str(), note.c_str());
+    messages.push_back("shapedb: warning: " + path + ": " + note);
+  char line[1024];
   if (flags.repair) {
     Result<volume::RepairedSurface> repair = volume::repairSurface(loaded->mesh, flags.repairOptions);
     if (!repair) return withContext(repair.error(), path + ": --repair");
@@ -76,12 +80,12 @@ Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags
                     100.0 * (r.volumeAfter / *r.volumeBefore - 1.0));
     else
       std::snprintf(volume, sizeof volume, "volume %.4g (none before: not closed)", r.volumeAfter);
-    std::fprintf(
-        stderr,
-        "shapedb: note: %s: repaired at %d voxels (%.3g each): %zu holes shut (closing radius %.3g), "
-        "%s, area %.4g -> %.4g, %zu -> %zu triangles\n",
-        path.c_str(), r.resolution, r.voxelSize, r.holes, r.closingRadius, volume, r.areaBefore, r.areaAfter,
-        r.trianglesBefore, r.trianglesAfter);
+    std::snprintf(line, sizeof line,
+                  "repaired at %d voxels (%.3g each): %zu holes shut (closing radius %.3g), %s, area %.4g -> "
+                  "%.4g, %zu -> %zu triangles",
+                  r.resolution, r.voxelSize, r.holes, r.closingRadius, volume, r.areaBefore, r.areaAfter,
+                  r.trianglesBefore, r.trianglesAfter);
+    messages.push_back("shapedb: note: " + path + ": " + line);
     loaded->mesh = std::move(repair->mesh);
     loaded->topology = core::analyzeTopology(loaded->mesh);
     if (repaired) *repaired = r;
@@ -89,19 +93,29 @@ Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags
   if (flags.units.empty() && !loaded->mesh.vertices.empty()) {
     const core::Bounds bounds = core::computeBounds(loaded->mesh);
     const double size = (bounds.max - bounds.min).maxCoeff();
-    if (size > 10.0)
-      std::fprintf(
-          stderr,
-          "shapedb: warning: %s: the mesh is %.4g m across, read in metres; if its unit is millimetres "
-          "(as CAD exports often are), give --units mm (inches: --units in)\n",
-          path.c_str(), size);
-    else if (size < 1e-3)
-      std::fprintf(
-          stderr,
-          "shapedb: warning: %s: the mesh is %.3g mm across, read in metres; if that is not its unit, "
-          "give --units or --scale\n",
-          path.c_str(), size * 1e3);
+    if (size > 10.0) {
+      std::snprintf(line, sizeof line,
+                    "the mesh is %.4g m across, read in metres; if its unit is millimetres (as CAD exports "
+                    "often are), give --units mm (inches: --units in)",
+                    size);
+      messages.push_back("shapedb: warning: " + path + ": " + line);
+    } else if (size < 1e-3) {
+      std::snprintf(line, sizeof line,
+                    "the mesh is %.3g mm across, read in metres; if that is not its unit, give --units or "
+                    "--scale",
+                    size * 1e3);
+      messages.push_back("shapedb: warning: " + path + ": " + line);
+    }
   }
+  return loaded;
+}
+
+Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags& flags,
+                                    std::optional<volume::RepairReport>* repaired) {
+  std::vector<std::string> messages;
+  Result<io::LoadedMesh> loaded = loadMeshFile(path, flags, repaired, messages);
+  for (const std::string& m : messages)
+    std::fprintf(stderr, "%s\n", m.c_str());
   return loaded;
 }
 

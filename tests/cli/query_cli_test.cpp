@@ -373,6 +373,57 @@ TEST(QueryCli, EveryRealMeshIsAnsweredWithAPlausibleMassInItsUnit) {
   }
 }
 
+// Files are read several at a time: over more files than a group holds, the answers come in the files'
+// order, and so do what reading them says (warnings, files that cannot be read) and then what querying
+// them says (surfaces refused); a file that fails leaves the others answered.
+TEST(QueryCli, ManyFilesAreAnsweredAndWarnedAboutInTheirOrder) {
+  test::ScratchDir dir("query-cli-many");
+  const auto db = dir / "small.db";
+  ASSERT_EQ(test::buildWithCli(db, 2, "box", 2).exitCode, 0);
+  std::vector<std::string> args = {"query", db.string(), "--json", "--no-fidelity"};
+  // Files in order: answered; warned about or unreadable (reading); refused (querying).
+  std::vector<std::string> answered, reading, querying;
+  for (int i = 0; i < 37; ++i) {
+    const auto path = dir / ("mesh-" + std::to_string(100 + i) + ".obj");
+    args.push_back(path.string());
+    if (i % 7 == 5) {
+      test::writeFile(path, "v 0 0 0\nf 1 2 3\n");  // a face on vertices the file lacks
+      reading.push_back(path.string());
+      continue;
+    }
+    core::TriangleMesh box = core::makeBox({1.0 + 0.05 * i, 2.0, 3.0});
+    if (i % 5 == 3) {
+      box.triangles.pop_back();  // open: refused
+      querying.push_back(path.string());
+    } else {
+      if (i % 5 == 1) {
+        for (auto& t : box.triangles)
+          std::swap(t[1], t[2]);  // wound inward: flipped, with a warning
+        reading.push_back(path.string());
+      }
+      answered.push_back(path.string());
+    }
+    ASSERT_TRUE(io::saveMesh(box, path).ok());
+  }
+  test::ProcessResult q = test::runProcess(SHAPEDB_CLI, args);
+  EXPECT_EQ(q.exitCode, 1) << "some files were refused";
+  const nlohmann::json queries = nlohmann::json::parse(q.out)["queries"];
+  ASSERT_EQ(queries.size(), answered.size());
+  for (std::size_t i = 0; i < answered.size(); ++i)
+    EXPECT_EQ(queries[i]["file"].get<std::string>(), answered[i]);
+  std::size_t at = 0;
+  for (const std::string& file : reading) {
+    const std::size_t found = q.err.find(file + ":", at);
+    ASSERT_NE(found, std::string::npos) << file << " is not reported after the files before it:\n" << q.err;
+    at = found + 1;
+  }
+  for (const std::string& file : querying) {
+    const std::size_t found = q.err.find(file + ":", at);
+    ASSERT_NE(found, std::string::npos) << file << " is not reported after the files before it:\n" << q.err;
+    at = found + 1;
+  }
+}
+
 TEST(QueryCli, BadInputsAreClearErrors) {
   test::ScratchDir dir("query-cli-bad");
   const auto db = dir / "small.db";
