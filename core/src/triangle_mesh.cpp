@@ -62,6 +62,14 @@ std::size_t removeUnusedVertices(TriangleMesh& mesh) {
   return dropped;
 }
 
+void removeTriangles(TriangleMesh& mesh, const std::vector<bool>& dropped) {
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (!dropped[t]) mesh.triangles[kept++] = mesh.triangles[t];
+  mesh.triangles.resize(kept);
+  removeUnusedVertices(mesh);
+}
+
 TriangleMesh transformed(const TriangleMesh& mesh, const Mat4& dstFromSrc) {
   TriangleMesh out;
   out.vertices.reserve(mesh.vertices.size());

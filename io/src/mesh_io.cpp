@@ -160,11 +160,7 @@ void dropSpecks(LoadedMesh& loaded) {
   }
   if (loaded.specksDropped == 0) return;
 
-  std::size_t keptTriangles = 0;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    if (!dropped[t]) mesh.triangles[keptTriangles++] = mesh.triangles[t];
-  mesh.triangles.resize(keptTriangles);
-  core::removeUnusedVertices(mesh);
+  core::removeTriangles(mesh, dropped);
   loaded.topology = core::analyzeTopology(mesh);
   loaded.specksAreaShare = droppedArea / total;
   // Of the volume, where what is kept bounds one (its shells' signed volumes sum to it).

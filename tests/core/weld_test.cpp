@@ -107,5 +107,19 @@ TEST(RemoveUnusedVertices, KeepsTheUsedOnesInTheirOrder) {
   EXPECT_EQ(removeUnusedVertices(mesh), 0u);
 }
 
+// Two tetrahedra's surfaces in one mesh: dropping the second's triangles drops its vertices too, and
+// leaves the first as it was.
+TEST(RemoveTriangles, DropsTheFlaggedTrianglesAndTheVerticesOnlyTheyUsed) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {5, 5, 5}, {1, 0, 0}, {6, 5, 5}, {0, 1, 0}, {5, 6, 5}, {0, 0, 1}, {5, 5, 6}};
+  mesh.triangles = {{0, 4, 2}, {1, 5, 3}, {0, 2, 6}, {1, 3, 7}, {2, 4, 6}, {3, 5, 7}, {0, 6, 4}, {1, 7, 5}};
+  const std::vector<bool> dropped = {false, true, false, true, false, true, false, true};
+  removeTriangles(mesh, dropped);
+  const std::vector<Vec3> kept = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  EXPECT_EQ(mesh.vertices, kept);
+  const std::vector<TriangleMesh::Triangle> first = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  EXPECT_EQ(mesh.triangles, first);
+}
+
 }  // namespace
 }  // namespace shapedb::core

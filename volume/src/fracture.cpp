@@ -43,21 +43,14 @@ void dropCrumbShells(TriangleMesh& piece, double crumbVolume, FractureResult& re
   if (std::all_of(shells.begin(), shells.end(), [&](const core::Shell& s) { return s.cavity || isCrumb(s); }))
     return;
   std::vector<bool> dropped(piece.triangles.size(), false);
-  bool any = false;
   for (const core::Shell& s : shells) {
     if (!isCrumb(s)) continue;
-    any = true;
     ++result.crumbsDropped;
     result.droppedVolume += std::abs(s.volume);
     for (const std::uint32_t t : s.triangles)
       dropped[t] = true;
   }
-  if (!any) return;
-  std::size_t kept = 0;
-  for (std::size_t t = 0; t < piece.triangles.size(); ++t)
-    if (!dropped[t]) piece.triangles[kept++] = piece.triangles[t];
-  piece.triangles.resize(kept);
-  core::removeUnusedVertices(piece);
+  core::removeTriangles(piece, dropped);
 }
 
 }  // namespace

@@ -53,6 +53,10 @@ void append(TriangleMesh& into, const TriangleMesh& part);
 /// are renumbered to match. Returns how many were dropped. Precondition: indices in range.
 std::size_t removeUnusedVertices(TriangleMesh& mesh);
 
+/// Drops the triangles whose flag in `dropped` (one per triangle) is set, and then the vertices only they
+/// used (removeUnusedVertices); the rest keep their order. A surface's shells taken out (specks, crumbs).
+void removeTriangles(TriangleMesh& mesh, const std::vector<bool>& dropped);
+
 /// The mesh with every triangle's winding reversed (an inside-out mesh turned right side out).
 TriangleMesh flipped(const TriangleMesh& mesh);
 
