@@ -121,6 +121,48 @@ TEST(Describe, ReorientedDescriptorEqualsDescribingInTheRotatedFrame) {
   EXPECT_FALSE(core::reorientDescriptor(Descriptor{}, turn).has_value());
 }
 
+// A round shape's frame is free to turn about its axis: 24 turns, and 48 where the axis's sign is
+// undetermined too, of which describeCandidates describes a quarter's worth from the surface and reindexes
+// the rest. Every candidate against describing the surface in its frame.
+TEST(Describe, EveryCandidateOfARoundShapeEqualsDescribingItInItsFrame) {
+  std::mt19937_64 rng(21);
+  struct Round {
+    TriangleMesh mesh;
+    std::size_t candidates;
+  };
+  const std::vector<Round> shapes = {
+      {core::makeCylinder(0.5, 3.0, 40), 48},  // mirror-symmetric: its axis may be reversed
+      {core::makeCone(1.0, 2.5, 40), 24},      // its axis points to its tip
+  };
+  for (const Round& round : shapes) {
+    const TriangleMesh mesh = core::transformed(round.mesh, test::randomSimilarity(rng));
+    for (DescriptorKind kind : {DescriptorKind::kVoxel, DescriptorKind::kCentroidVoxel}) {
+      const DescriptorOptions options = test::descriptorOptions(kind, Sampling::kArea);
+      Result<test::DescribedMesh> described = test::describeMesh(mesh, options);
+      ASSERT_TRUE(described.ok());
+      const core::Normalization& normalization = described->normalization;
+      ASSERT_EQ(normalization.planeSymmetry, 0);
+      Describer describer(options);
+      const Result<std::vector<Descriptor>> candidates = describer.describeCandidates(mesh, normalization);
+      ASSERT_TRUE(candidates.ok());
+      ASSERT_EQ(candidates->size(), round.candidates);
+      const std::vector<core::Mat3> rotations = core::orientationCandidates(normalization);
+      for (std::size_t c = 0; c < candidates->size(); ++c) {
+        SCOPED_TRACE("candidate " + std::to_string(c));
+        const Descriptor& reused = (*candidates)[c];
+        EXPECT_EQ(reused.orientation, rotations[c]);
+        const Result<Descriptor> direct = describer.describe(mesh, normalization, rotations[c]);
+        ASSERT_TRUE(direct.ok());
+        ASSERT_EQ(reused.cells, direct->cells);
+        for (std::size_t i = 0; i < direct->cells.size(); ++i) {
+          EXPECT_LT((reused.centroids[i] - direct->centroids[i]).norm(), 1e-9);
+          EXPECT_NEAR(reused.weights[i], direct->weights[i], 1e-9 * direct->weights[i]);
+        }
+      }
+    }
+  }
+}
+
 TEST(Describe, VertexSamplingBinsTheVerticesAsThePaperDoes) {
   const TriangleMesh mesh = test::makeLopsidedBlob(Vec3(1.0, 0.7, 0.5), 2);
   const Descriptor d =

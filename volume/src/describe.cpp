@@ -543,16 +543,25 @@ Result<std::vector<core::Descriptor>> Describer::describeCandidates(
                                           ? std::vector<Mat3>{Mat3::Identity()}
                                           : core::orientationCandidates(normalization, orientation);
   out.reserve(rotations.size());
+  // With area sampling, a candidate that differs from one described before by a rotation that only
+  // permutes or reverses axes is that one's grid reindexed: the sign flips of a generic shape and the
+  // quarter turns of a square section are the canonical grid's, and of a round shape's 24 turns of 15°
+  // (48 with its axis reversed) only the six turns of 0-75° are described, the others being quarter
+  // turns and reversals of those.
+  std::vector<std::size_t> described;  // the candidates described from the surface
   for (const Mat3& rotation : rotations) {
-    // With area sampling, a candidate that only permutes or reverses axes (the sign flips of a
-    // generic shape, the quarter turns of a square section) is the canonical grid reindexed.
-    if (!out.empty() && mOptions.sampling == Sampling::kArea)
-      if (std::optional<core::Descriptor> d = core::reorientDescriptor(out.front(), rotation)) {
-        out.push_back(std::move(*d));
-        continue;
-      }
+    std::optional<core::Descriptor> reindexed;
+    if (mOptions.sampling == Sampling::kArea)
+      for (std::size_t k : described)
+        if ((reindexed = core::reorientDescriptor(out[k], rotation * out[k].orientation.transpose()))) break;
+    if (reindexed) {
+      reindexed->orientation = rotation;  // the candidate's own, not the product's round-off
+      out.push_back(std::move(*reindexed));
+      continue;
+    }
     Result<core::Descriptor> d = describe(mesh, normalization, rotation);
     if (!d) return d.error();
+    described.push_back(out.size());
     out.push_back(std::move(d).value());
   }
   return out;
