@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -19,20 +21,28 @@ const Mat3 kFlipXY = Vec3(-1.0, -1.0, 1.0).asDiagonal();
 
 }  // namespace
 
-std::vector<Mat3> sampleRotations(int count) {
-  // Super-Fibonacci spirals: quaternions from two irrational rotation numbers.
-  const double phi = std::sqrt(2.0);
-  const double psi = 1.533751168755204288118041;
+std::vector<Mat3> sphereCandidates(int cosets) {
+  // Found by minimizing, over pairs of rotations, the largest angle from random rotations to the nearest
+  // of the three cosets (quaternions w, x, y, z).
+  const std::array<Eigen::Quaterniond, kMaxSphereCosets> bases = {
+      Eigen::Quaterniond::Identity(),
+      Eigen::Quaterniond(-0.575699, -0.632761, -0.034341, 0.516725).normalized(),
+      Eigen::Quaterniond(-0.048573, 0.499023, 0.637373, -0.585126).normalized(),
+  };
+  std::vector<Mat3> cube;  // the identity first
+  std::array<int, 3> axes = {0, 1, 2};
+  do {
+    for (int signs = 0; signs < 8; ++signs) {
+      Mat3 g = Mat3::Zero();
+      for (int row = 0; row < 3; ++row)
+        g(row, axes[static_cast<std::size_t>(row)]) = ((signs >> row) & 1) != 0 ? -1.0 : 1.0;
+      if (g.determinant() > 0.0) cube.push_back(g);
+    }
+  } while (std::next_permutation(axes.begin(), axes.end()));
   std::vector<Mat3> out;
-  out.reserve(static_cast<std::size_t>(std::max(count, 0)));
-  for (int i = 0; i < count; ++i) {
-    const double s = i + 0.5;
-    const double r = std::sqrt(s / count), R = std::sqrt(1.0 - s / count);
-    const double alpha = 2.0 * std::numbers::pi * s / phi, beta = 2.0 * std::numbers::pi * s / psi;
-    const Eigen::Quaterniond q(R * std::cos(beta), r * std::sin(alpha), r * std::cos(alpha),
-                               R * std::sin(beta));
-    out.push_back(q.normalized().toRotationMatrix());
-  }
+  for (int c = 0; c < std::clamp(cosets, 1, kMaxSphereCosets); ++c)
+    for (const Mat3& g : cube)
+      out.push_back(g * bases[static_cast<std::size_t>(c)].toRotationMatrix());
   return out;
 }
 
@@ -66,8 +76,7 @@ std::vector<Mat3> orientationCandidates(const Normalization& normalization,
       aroundAxis(Vec3::UnitX(), reverse, kFlipXZ);
       break;
     case AxisDegeneracy::kAll:
-      for (const Mat3& rotation : sampleRotations(options.sphereSamples))
-        out.push_back(rotation);
+      out = sphereCandidates(options.sphereCosets);
       break;
   }
   return out;
