@@ -188,6 +188,22 @@ Vec3 dequantizeCentroid(std::uint16_t code) {
   return Vec3((code & 31) + 0.5, ((code >> 5) & 31) + 0.5, ((code >> 10) & 31) + 0.5) / kQuantLevels;
 }
 
+namespace {
+
+// Whether the index compares descriptors a and b of its kind with every entry alike: the same moments
+// and, for the grid kinds, the same filled cells and (centroid-voxel) quantized centroids.
+bool seenAlike(DescriptorKind kind, const Descriptor& a, const Descriptor& b) {
+  if (a.moments != b.moments) return false;
+  if (!isGrid(kind)) return true;
+  if (a.cells != b.cells) return false;
+  if (kind != DescriptorKind::kCentroidVoxel) return true;
+  for (std::size_t i = 0; i < a.centroids.size(); ++i)
+    if (quantizeCentroid(a.centroids[i]) != quantizeCentroid(b.centroids[i])) return false;
+  return true;
+}
+
+}  // namespace
+
 const char* toString(SearchMethod method) {
   switch (method) {
     case SearchMethod::kBruteForce:
@@ -702,10 +718,21 @@ Result<std::vector<Match>> Index::Impl::search(std::span<const Descriptor> candi
   SearchStats local;
   SearchStats& st = stats ? *stats : local;
   const auto k = static_cast<std::size_t>(options.k);
+  // A candidate that the index sees as an earlier one (the same cells, quantized centroids and moments:
+  // often most turns of a round shape) has that one's distance to every entry and loses its ties to it:
+  // the pruned searches leave it out. Brute force, the oracle, compares every candidate.
+  const bool everyCandidate = !options.among.empty() || options.method == SearchMethod::kBruteForce;
   std::vector<Query> queries;
   queries.reserve(candidates.size());
-  for (std::size_t c = 0; c < candidates.size(); ++c)
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const auto alike = [&](const Descriptor& earlier) {
+      return seenAlike(mOptions.kind, earlier, candidates[c]);
+    };
+    if (!everyCandidate &&
+        std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(c), alike))
+      continue;
     queries.push_back(prepare(candidates[c], static_cast<int>(c), options.momentWeight));
+  }
 
   if (!std::is_sorted(options.among.begin(), options.among.end(), std::less_equal<>()))
     return Error{ErrorCode::kInvalidArgument,

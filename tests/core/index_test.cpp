@@ -41,7 +41,10 @@ std::vector<Descriptor> jitteredEntries(const std::vector<Descriptor>& bases, in
   return entries;
 }
 
-// A query: one to three orientation candidates, each a jittered copy of one random base.
+// A query: one to three orientation candidates, each a jittered copy of one random base; and on every
+// other query, copies of those put among them, as a round shape's turns often are: one the same, one whose
+// centroids moved by far less than the index quantizes them to, one with a centroid moved by a tenth
+// of its cell (which the pruned search must not take for the same).
 std::vector<Descriptor> queryCandidates(const std::vector<Descriptor>& bases, std::mt19937_64& rng) {
   std::uniform_int_distribution<int> flips(0, 10), pickCandidates(1, 3);
   std::uniform_int_distribution<std::size_t> pickBase(0, bases.size() - 1);
@@ -49,6 +52,21 @@ std::vector<Descriptor> queryCandidates(const std::vector<Descriptor>& bases, st
   std::vector<Descriptor> candidates;
   for (int c = pickCandidates(rng); c > 0; --c)
     candidates.push_back(test::jitterDescriptor(base, rng, flips(rng) + 2, 0.2));
+  if (std::bernoulli_distribution(0.5)(rng)) {
+    std::vector<Descriptor> copies;
+    for (int variant = 0; variant < 3; ++variant) {
+      Descriptor copy = candidates[std::uniform_int_distribution<std::size_t>(0, candidates.size() - 1)(rng)];
+      for (Vec3& c : copy.centroids) {
+        if (variant == 1) c = (c.array() + 1e-12).min(1.0).matrix();
+        if (variant == 2 && &c == &copy.centroids.front()) c = (c.array() + 0.1).min(1.0).matrix();
+      }
+      copies.push_back(std::move(copy));
+    }
+    for (Descriptor& copy : copies) {
+      const auto at = std::uniform_int_distribution<std::size_t>(0, candidates.size())(rng);
+      candidates.insert(candidates.begin() + static_cast<std::ptrdiff_t>(at), std::move(copy));
+    }
+  }
   return candidates;
 }
 
@@ -78,7 +96,8 @@ void expectSameMatches(const std::vector<Match>& a, const std::vector<Match>& b,
 }
 
 // Pruned search against brute force: `queries` random queries against `entryCount` jittered entries,
-// with k from 1 to 10, one to three orientation candidates per query, and moment weights 0, 1 and 5.
+// with k from 1 to 10, one to six orientation candidates per query (some of them alike), and moment
+// weights 0, 1 and 5.
 void expectPrunedEqualsBruteForce(DescriptorKind kind, int entryCount, int queries) {
   const std::vector<Descriptor> bases = baseDescriptors(kind, 150, 42);
   std::mt19937_64 rng(99);

@@ -152,7 +152,8 @@ struct QueryResult {
   /// several solids, or with cavities answered by a generated entry: the model was fitted on single solids
   /// without cavities (physics->warnings says which).
   std::optional<double> predictedFrequencyError;
-  std::size_t orientationCandidates = 0;  ///< descriptors searched (orientations)
+  std::size_t orientationCandidates =
+      0;  ///< orientations tried (the search skips those its index sees alike)
   QueryTimes times;
 };
 
