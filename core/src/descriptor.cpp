@@ -29,6 +29,9 @@ Status validateDescriptor(const Descriptor& d, const DescriptorOptions& options)
     return fail(std::string("is ") + toString(d.kind) + ", expected " + toString(options.kind));
   if (!d.moments.allFinite()) return fail("moments are not finite");
   if (d.kind == DescriptorKind::kMoment) return Ok{};
+  if (options.gridSize < 2 || options.gridSize > kMaxGridSize)
+    return fail("grid " + std::to_string(options.gridSize) + " is outside [2, " +
+                std::to_string(kMaxGridSize) + "]");
   if (d.sampling != options.sampling || d.gridSize != options.gridSize)
     return fail("grid " + std::to_string(d.gridSize) + " with " + toString(d.sampling) +
                 " sampling, expected " + std::to_string(options.gridSize) + " with " +

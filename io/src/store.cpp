@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sqlite3.h>
 
+#include <shapedb/core/descriptor.h>
 #include <shapedb/io/store.h>
 
 #include "codec.h"
@@ -185,6 +186,10 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
                                           std::to_string(volume::kMaxStoneSubdivisions)};
     volume::EntryOptions& e = p.entry;
     e.descriptor.gridSize = j.at("descriptor").at("grid").get<int>();
+    if (e.descriptor.gridSize < 2 || e.descriptor.gridSize > core::kMaxGridSize)
+      return Error{ErrorCode::kParse, "the build parameters' descriptor grid must be 2 to " +
+                                          std::to_string(core::kMaxGridSize) + " cells across, not " +
+                                          std::to_string(e.descriptor.gridSize)};
     const auto sampling = core::parseSampling(j.at("descriptor").at("sampling").get<std::string>());
     if (!sampling) return Error{ErrorCode::kParse, "unknown sampling in the build parameters"};
     e.descriptor.sampling = *sampling;

@@ -377,6 +377,13 @@ TEST(Index, RejectsMismatchedQueriesAndDuplicateIds) {
   bad = bases[0];
   bad.moments[1] = std::nan("");
   EXPECT_NE(strict.add(1, bad).error().message.find("not finite"), std::string::npos);
+  // A builder for a grid no descriptor may have (its tables would be out of range) takes no entry.
+  DescriptorOptions huge = test::descriptorOptions(DescriptorKind::kVoxel);
+  huge.gridSize = kMaxGridSize + 1;
+  IndexBuilder tooLarge(huge);
+  bad = bases[0];
+  bad.gridSize = huge.gridSize;
+  EXPECT_NE(tooLarge.add(1, bad).error().message.find("outside [2, 64]"), std::string::npos);
 
   IndexBuilder builder(test::descriptorOptions(DescriptorKind::kVoxel));
   ASSERT_TRUE(builder.add(4, bases[0]).ok());

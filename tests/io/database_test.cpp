@@ -871,6 +871,21 @@ TEST(BuildParametersJson, FamilyWeightsRoundTripAndOlderFilesAreEven) {
   }
 }
 
+// A file's descriptor grid sizes its index's tables: one outside what a descriptor may have is a foreign
+// or damaged file, refused when its parameters are read.
+TEST(BuildParametersJson, ADescriptorGridOutOfRangeIsRefused) {
+  nlohmann::json stored = nlohmann::json::parse(toJson(BuildParameters{}));
+  for (int grid : {0, 1, core::kMaxGridSize + 1, 1000}) {
+    stored["descriptor"]["grid"] = grid;
+    Result<BuildParameters> back = parseBuildParameters(stored.dump());
+    ASSERT_FALSE(back.ok()) << grid;
+    EXPECT_NE(back.error().message.find("descriptor grid must be 2 to 64"), std::string::npos)
+        << back.error().message;
+  }
+  stored["descriptor"]["grid"] = core::kMaxGridSize;
+  EXPECT_TRUE(parseBuildParameters(stored.dump()).ok());
+}
+
 TEST_F(SmallDatabase, OtherDescriptorParametersAreAClearError) {
   core::DescriptorOptions other;
   other.gridSize = 12;

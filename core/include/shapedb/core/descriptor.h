@@ -79,9 +79,9 @@ struct Descriptor {
 };
 
 /// Checks that `d` is a well-formed descriptor of the kind, sampling and grid size `options` name:
-/// finite moments; for the voxel kinds, cells strictly ascending and below N³, one centroid per cell
-/// (centroid-voxel), each coordinate in [0, 1]. What the index checks before it trusts a descriptor
-/// (a query's, or an entry's read back from a file).
+/// finite moments; for the voxel kinds, a grid of 2 to kMaxGridSize cells across, cells strictly
+/// ascending and below N³, one centroid per cell (centroid-voxel), each coordinate in [0, 1]. What the
+/// index checks before it trusts a descriptor (a query's, or an entry's read back from a file).
 /// Errors: kInvalidArgument naming the first problem.
 Status validateDescriptor(const Descriptor& d, const DescriptorOptions& options);
 
