@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <string>
 
@@ -62,24 +63,46 @@ constexpr std::size_t kSlabBytes = 3 * kProfileBins;
 constexpr std::size_t kProfileBytes = kSlabBytes + kBlocksPerAxis * kBlocksPerAxis * kBlocksPerAxis;
 using CountProfile = std::array<std::uint8_t, kProfileBytes>;
 
-// Filled cells per part of four partitions of the grid: slabs along x, y and z (16 bins each; with
-// N > 16 adjacent slabs share a bin) and a coarse 4³ block grid. Counts saturate at 255, which keeps
-// |a − b| ≤ the true difference, so the bounds stay valid.
+// The parts of the four partitions below that each cell of an N³ grid falls in: its x, y and z slab
+// (16 bins each; with N > 16 adjacent slabs share a bin), as indices into a profile's slab counts, and
+// its block of the coarse 4³ grid. One table per grid size, made once.
+using CellParts = std::array<std::uint8_t, 4>;
+const std::vector<CellParts>& cellParts(int n) {
+  static std::array<std::once_flag, kMaxGridSize + 1> made;
+  static std::array<std::vector<CellParts>, kMaxGridSize + 1> tables;
+  const auto size = static_cast<std::size_t>(n);
+  std::call_once(made[size], [&] {
+    const auto bin = [n](int i, int bins) { return i * bins / std::max(n, bins); };
+    std::vector<CellParts>& table = tables[size];
+    table.resize(size * size * size);
+    for (std::uint32_t cell = 0; cell < table.size(); ++cell) {
+      const std::array<int, 3> ijk = cellCoordinates(cell, n);
+      for (int axis = 0; axis < 3; ++axis)
+        table[cell][static_cast<std::size_t>(axis)] = static_cast<std::uint8_t>(
+            axis * kProfileBins + bin(ijk[static_cast<std::size_t>(axis)], kProfileBins));
+      table[cell][3] = static_cast<std::uint8_t>(
+          bin(ijk[0], kBlocksPerAxis) +
+          kBlocksPerAxis * (bin(ijk[1], kBlocksPerAxis) + kBlocksPerAxis * bin(ijk[2], kBlocksPerAxis)));
+    }
+  });
+  return tables[size];
+}
+
+// Filled cells per part of four partitions of the grid: slabs along x, y and z and a coarse 4³ block
+// grid (cellParts). Counts saturate at 255, which keeps |a − b| ≤ the true difference, so the bounds
+// stay valid.
 CountProfile countProfile(const std::uint64_t* bits, int n) {
   std::array<int, 48> slabs{};
   std::array<int, 64> blocks{};
   const int cells = n * n * n;
-  const auto bin = [n](int i, int bins) { return i * bins / std::max(n, bins); };
+  const std::vector<CellParts>& parts = cellParts(n);
   for (int w = 0; w * 64 < cells; ++w)
     for (std::uint64_t word = bits[w]; word != 0; word &= word - 1) {
-      const int cell = w * 64 + std::countr_zero(word);
-      const std::array<int, 3> ijk = cellCoordinates(static_cast<std::uint32_t>(cell), n);
-      for (int axis = 0; axis < 3; ++axis)
-        ++slabs[static_cast<std::size_t>(axis * kProfileBins +
-                                         bin(ijk[static_cast<std::size_t>(axis)], kProfileBins))];
-      ++blocks[static_cast<std::size_t>(
-          bin(ijk[0], kBlocksPerAxis) +
-          kBlocksPerAxis * (bin(ijk[1], kBlocksPerAxis) + kBlocksPerAxis * bin(ijk[2], kBlocksPerAxis)))];
+      const CellParts& p = parts[static_cast<std::size_t>(w * 64 + std::countr_zero(word))];
+      ++slabs[p[0]];
+      ++slabs[p[1]];
+      ++slabs[p[2]];
+      ++blocks[p[3]];
     }
   CountProfile out{};
   for (std::size_t i = 0; i < slabs.size(); ++i)
@@ -187,22 +210,6 @@ std::uint16_t quantizeCentroid(const Vec3& centroid) {
 Vec3 dequantizeCentroid(std::uint16_t code) {
   return Vec3((code & 31) + 0.5, ((code >> 5) & 31) + 0.5, ((code >> 10) & 31) + 0.5) / kQuantLevels;
 }
-
-namespace {
-
-// Whether the index compares descriptors a and b of its kind with every entry alike: the same moments
-// and, for the grid kinds, the same filled cells and (centroid-voxel) quantized centroids.
-bool seenAlike(DescriptorKind kind, const Descriptor& a, const Descriptor& b) {
-  if (a.moments != b.moments) return false;
-  if (!isGrid(kind)) return true;
-  if (a.cells != b.cells) return false;
-  if (kind != DescriptorKind::kCentroidVoxel) return true;
-  for (std::size_t i = 0; i < a.centroids.size(); ++i)
-    if (quantizeCentroid(a.centroids[i]) != quantizeCentroid(b.centroids[i])) return false;
-  return true;
-}
-
-}  // namespace
 
 const char* toString(SearchMethod method) {
   switch (method) {
@@ -722,15 +729,23 @@ Result<std::vector<Match>> Index::Impl::search(std::span<const Descriptor> candi
   // often most turns of a round shape) has that one's distance to every entry and loses its ties to it:
   // the pruned searches leave it out. Brute force, the oracle, compares every candidate.
   const bool everyCandidate = !options.among.empty() || options.method == SearchMethod::kBruteForce;
+  std::vector<std::vector<std::uint16_t>> codes(candidates.size());  // centroid-voxel: as the index has them
+  const auto alike = [&](std::size_t a, std::size_t b) {
+    return candidates[a].moments == candidates[b].moments && candidates[a].cells == candidates[b].cells &&
+           codes[a] == codes[b];
+  };
   std::vector<Query> queries;
   queries.reserve(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
-    const auto alike = [&](const Descriptor& earlier) {
-      return seenAlike(mOptions.kind, earlier, candidates[c]);
-    };
-    if (!everyCandidate &&
-        std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(c), alike))
-      continue;
+    if (!everyCandidate) {
+      if (mOptions.kind == DescriptorKind::kCentroidVoxel)
+        for (const Vec3& centroid : candidates[c].centroids)
+          codes[c].push_back(quantizeCentroid(centroid));
+      bool seen = false;
+      for (std::size_t e = 0; e < c && !seen; ++e)
+        seen = alike(e, c);
+      if (seen) continue;
+    }
     queries.push_back(prepare(candidates[c], static_cast<int>(c), options.momentWeight));
   }
 
