@@ -262,7 +262,9 @@ struct Index::Impl {
     for (std::size_t at = 0; at < bytes; at += 64)
       __builtin_prefetch(first + at);
   }
-  Query prepare(const Descriptor& descriptor, int candidate, double momentWeight) const;
+  /// `codes`: the descriptor's centroids quantized (centroid-voxel; empty for the other kinds).
+  Query prepare(const Descriptor& descriptor, const std::vector<std::uint16_t>& codes, int candidate,
+                double momentWeight) const;
   double momentTerm(const Query& q, std::size_t slot) const;
   double gridDistance(const Query& q, std::size_t slot, double threshold, double moments) const;
   double gridBound(const Query& q, std::size_t slot, double moments) const;
@@ -372,7 +374,8 @@ std::size_t Index::Impl::memoryBytes() const {
          bytesOf(mClusters) + bytesOf(mClusterBits) + bytesOf(mNodes);
 }
 
-Index::Impl::Query Index::Impl::prepare(const Descriptor& d, int candidate, double momentWeight) const {
+Index::Impl::Query Index::Impl::prepare(const Descriptor& d, const std::vector<std::uint16_t>& codes,
+                                        int candidate, double momentWeight) const {
   Query q;
   q.candidate = candidate;
   q.moments = d.moments;
@@ -386,7 +389,7 @@ Index::Impl::Query Index::Impl::prepare(const Descriptor& d, int candidate, doub
   if (mOptions.kind == DescriptorKind::kCentroidVoxel) {
     q.dense.assign(static_cast<std::size_t>(mWords) * 64, 0);
     for (std::size_t i = 0; i < d.cells.size(); ++i)
-      q.dense[d.cells[i]] = quantizeCentroid(d.centroids[i]);
+      q.dense[d.cells[i]] = codes[i];
   }
   return q;
 }
@@ -737,16 +740,13 @@ Result<std::vector<Match>> Index::Impl::search(std::span<const Descriptor> candi
   std::vector<Query> queries;
   queries.reserve(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
-    if (!everyCandidate) {
-      if (mOptions.kind == DescriptorKind::kCentroidVoxel)
-        for (const Vec3& centroid : candidates[c].centroids)
-          codes[c].push_back(quantizeCentroid(centroid));
-      bool seen = false;
-      for (std::size_t e = 0; e < c && !seen; ++e)
-        seen = alike(e, c);
-      if (seen) continue;
-    }
-    queries.push_back(prepare(candidates[c], static_cast<int>(c), options.momentWeight));
+    if (mOptions.kind == DescriptorKind::kCentroidVoxel)
+      for (const Vec3& centroid : candidates[c].centroids)
+        codes[c].push_back(quantizeCentroid(centroid));
+    bool seen = false;
+    for (std::size_t e = 0; e < c && !seen && !everyCandidate; ++e)
+      seen = alike(e, c);
+    if (!seen) queries.push_back(prepare(candidates[c], codes[c], static_cast<int>(c), options.momentWeight));
   }
 
   if (!std::is_sorted(options.among.begin(), options.among.end(), std::less_equal<>()))
