@@ -40,7 +40,8 @@ void dropCrumbShells(TriangleMesh& piece, double crumbVolume, FractureResult& re
   const auto isCrumb = [crumbVolume](const core::Shell& s) {
     return !s.cavity && std::abs(s.volume) < crumbVolume;
   };
-  if (std::all_of(shells.begin(), shells.end(), [&](const core::Shell& s) { return s.cavity || isCrumb(s); }))
+  if (std::none_of(shells.begin(), shells.end(), isCrumb) ||
+      std::all_of(shells.begin(), shells.end(), [&](const core::Shell& s) { return s.cavity || isCrumb(s); }))
     return;
   std::vector<bool> dropped(piece.triangles.size(), false);
   for (const core::Shell& s : shells) {
