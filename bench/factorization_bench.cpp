@@ -1,10 +1,10 @@
 // The modal analysis's factorization (volume/src/sparse_cholesky.h) on the quadratic-tet matrices K − σM of
 // database entries: Eigen's simplicial LDLᵀ (the first solver, the baseline), and CHOLMOD's LLᵀ by each of
 // its methods, simplicial and supernodal, with the one SparseCholesky's automatic choice takes (its
-// threshold depends on the BLAS loaded: Debian's alternatives choose it; LD_LIBRARY_PATH, say
-// /usr/lib/x86_64-linux-gnu/blis-serial:/usr/lib/x86_64-linux-gnu/lapack, overrides them). For one
-// entry of each family: the degrees of freedom, each solver's factorization, one solve, and one solve with
-// 20 right-hand sides (milliseconds, best of three), and how far the automatic choice's solution is from
+// threshold depends on the processor and the BLAS loaded: Debian's alternatives choose it; LD_LIBRARY_PATH,
+// say /usr/lib/x86_64-linux-gnu/blis-serial:/usr/lib/x86_64-linux-gnu/lapack, overrides them). For one entry
+// of each family: the degrees of freedom, each solver's factorization, one solve, and one solve with 20
+// right-hand sides (milliseconds, best of three), and how far the automatic choice's solution is from
 // Eigen's. Each factorization includes its analysis: Eigen's with its AMD on the scalar graph, CHOLMOD's
 // with the node-block order the modal analysis gives it. Run it on one core (taskset -c 0): the build
 // runs one factorization per core.

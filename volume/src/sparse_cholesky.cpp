@@ -100,8 +100,13 @@ struct CallGuard {
 }  // namespace
 
 double supernodalSwitch() {
-  constexpr double kOpenBlas = 135.0, kOtherBlas = 175.0;  // the header says where they were measured
-  return openBlasParallel() ? kOpenBlas : kOtherBlas;
+  // The header says where these were measured.
+  constexpr double kOpenBlasIntel = 40.0, kOpenBlas = 135.0, kOtherBlas = 175.0;
+  if (!openBlasParallel()) return kOtherBlas;
+#if defined(__x86_64__) || defined(__i386__)
+  if (__builtin_cpu_is("intel")) return kOpenBlasIntel;
+#endif
+  return kOpenBlas;
 }
 
 std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix) {

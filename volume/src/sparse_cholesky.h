@@ -29,11 +29,14 @@ enum class CholeskyMethod { kAuto, kSimplicial, kSupernodal };
 
 /// kAuto's threshold: supernodal where the factorization's flops per entry of the factor (CHOLMOD's fl /
 /// lnz, known after the analysis) reach it. It depends on the BLAS the supernodal method's dense blocks go
-/// through, measured on the default catalog's entries, for a factorization alone and with the 64 solves
-/// the modal analysis makes (bench/results/epyc-2core/factorization_2026-11-28.md): 135 with OpenBLAS (the
-/// one scripts/setup.sh installs: its cost per call on small blocks is low), 175 with any other (BLIS, the
-/// reference BLAS: the slender entries and the registration's systems, 74-152, are then 1.5-6× faster
-/// column by column). CHOLMOD's own default, 40, sends nearly every matrix to the supernodal method.
+/// through and on the processor, measured on the default catalog's entries, for a factorization alone and
+/// with the ~50 solves the modal analysis makes: with OpenBLAS (the one scripts/setup.sh installs: its
+/// cost per call on small blocks is low), 135 on an AMD EPYC
+/// (bench/results/epyc-2core/factorization_2026-11-28.md) and CHOLMOD's own default, 40, on an Intel Xeon,
+/// where the supernodal method factorizes the slender entries 1.5-2× faster than on the EPYC and the
+/// simplicial one no faster (bench/results/xeon-2core/supernodal_switch_2026-11-29.md): Intel processors
+/// take 40, any other 135. With any other BLAS (BLIS, the reference BLAS: the slender entries and the
+/// registration's systems, 74-152, are then 1.5-6× faster column by column), 175.
 double supernodalSwitch();
 
 class SparseCholesky {
