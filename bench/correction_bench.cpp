@@ -5,16 +5,26 @@
 // of the catalog, so its medians are a default entry's): the entry's tets and the quadratic mesh's degrees
 // of freedom, the morph's and the modes' median time, the median count of the modes' solves with the
 // factorized K − σM (Lanczos's operations), and the whole correction's median and p90 (milliseconds).
+// With --check, each correction's modes are also computed as an entry's are (computeModes: a random start,
+// converged to 1e-10, outside the timings), and the bench reports how far the correction's are from them:
+// the largest relative difference of the twenty frequencies, and of the shapes 1 − MAC (the squared
+// cosine between the two, at the corners) over the modes whose neighbours' frequencies are over 1 % away
+// (a closer pair's shapes are any basis of their plane).
 // Run it on one core (taskset -c 0): a query corrects on one, and so does a haptic worker. Freed memory is
 // kept in the heap as the command-line tool keeps it (cli/main.cpp): otherwise page faults on the
 // matrices' fresh blocks add ~40 % to the modes of a small entry on a VM.
-//   build/release/bin/correction_bench DB [--every K] [--seed S]
+//   build/release/bin/correction_bench DB [--every K] [--seed S] [--check]
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <numeric>
 #include <random>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #if defined(__GLIBC__)
@@ -37,7 +47,24 @@ struct Sample {
   std::size_t tets = 0;
   double dof = 0.0, morphMs = 0.0, modesMs = 0.0;
   int solves = 0;  ///< Lanczos's solves with the factorized K − σM (CorrectionReport::solves)
+  double frequencyError = 0.0, shapeError = 0.0;  ///< against computeModes, with --check
 };
+
+// The largest relative difference of the frequencies of `a` and `b` (the same modes), and the largest
+// 1 − MAC of their shapes over the modes isolated in `b` by over 1 % in frequency.
+std::pair<double, double> modeDifference(const core::ModalData& a, const core::ModalData& b) {
+  double frequency = 0.0, shape = 0.0;
+  const Eigen::Index m = std::min(a.eigenvalues.size(), b.eigenvalues.size());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    frequency = std::max(frequency, std::abs(std::sqrt(a.eigenvalues[i] / b.eigenvalues[i]) - 1.0));
+    const bool isolated = (i == 0 || b.eigenvalues[i] > 1.01 * b.eigenvalues[i - 1]) &&
+                          (i + 1 == m || b.eigenvalues[i + 1] > 1.01 * b.eigenvalues[i]);
+    if (!isolated) continue;
+    const double c = a.shapes.col(i).dot(b.shapes.col(i));
+    shape = std::max(shape, 1.0 - c * c / (a.shapes.col(i).squaredNorm() * b.shapes.col(i).squaredNorm()));
+  }
+  return {frequency, shape};
+}
 
 // The stretch: a random rotation's axes scaled by factors in [0.85, 1.15], about the origin (the entry's
 // centre of mass in its canonical frame).
@@ -48,9 +75,12 @@ core::Mat3 randomStretch(std::mt19937_64& rng) {
   return r * s.asDiagonal() * r.transpose();
 }
 
-void printRow(const std::string& name, const std::vector<Sample>& samples) {
+void printRow(const std::string& name, const std::vector<Sample>& samples, bool check) {
   std::vector<double> tets, dof, morph, modes, total, solves;
+  double frequencyError = 0.0, shapeError = 0.0;
   for (const Sample& s : samples) {
+    frequencyError = std::max(frequencyError, s.frequencyError);
+    shapeError = std::max(shapeError, s.shapeError);
     tets.push_back(static_cast<double>(s.tets));
     solves.push_back(s.solves);
     dof.push_back(s.dof);
@@ -58,10 +88,13 @@ void printRow(const std::string& name, const std::vector<Sample>& samples) {
     modes.push_back(s.modesMs);
     total.push_back(s.morphMs + s.modesMs);
   }
-  std::printf("| %s | %zu | %.0f | %.0f | %.1f | %.1f | %.0f | %.1f | %.1f |\n", name.c_str(), samples.size(),
-              core::percentile(tets, 0.5), core::percentile(dof, 0.5), core::percentile(morph, 0.5),
-              core::percentile(modes, 0.5), core::percentile(solves, 0.5), core::percentile(total, 0.5),
-              core::percentile(total, 0.9));
+  std::printf("| %s | %zu | %.0f | %.0f | %.1f | %.1f | %.0f | %.1f | %.1f | %.1f |", name.c_str(),
+              samples.size(), core::percentile(tets, 0.5), core::percentile(dof, 0.5),
+              core::percentile(morph, 0.5), core::percentile(modes, 0.5), core::percentile(solves, 0.5),
+              std::accumulate(solves.begin(), solves.end(), 0.0) / static_cast<double>(solves.size()),
+              core::percentile(total, 0.5), core::percentile(total, 0.9));
+  if (check) std::printf(" %.1e | %.1e |", frequencyError, shapeError);
+  std::printf("\n");
 }
 
 }  // namespace
@@ -82,6 +115,9 @@ int main(int argc, char** argv) {
     if (flag == "--every") every = static_cast<std::size_t>(std::max(1, std::atoi(argv[++i])));
     if (flag == "--seed") seed = std::strtoull(argv[++i], nullptr, 10);
   }
+  bool check = false;
+  for (int i = 2; i < argc; ++i)
+    check = check || std::string(argv[i]) == "--check";
   auto db = io::Database::open(argv[1]);
   if (!db) {
     std::fprintf(stderr, "%s: %s\n", argv[1], db.error().message.c_str());
@@ -105,7 +141,10 @@ int main(int argc, char** argv) {
     const core::Mat3 stretch = randomStretch(rng);
     for (core::Vec3& v : target.vertices)
       v = stretch * v;
-    auto corrected = volume::correctGeometry(**physics, target, modal);
+    // correctGeometry's two halves, so that --check can compute the same modes again.
+    auto morphed = volume::morphEntry(**physics, target);
+    auto corrected = morphed ? volume::correctMorphed(**physics, *morphed, modal)
+                             : Result<volume::CorrectedEntry>(morphed.error());
     if (!corrected) {
       std::fprintf(stderr, "%s: %s\n", record.name.c_str(), corrected.error().message.c_str());
       ++failed;
@@ -120,16 +159,35 @@ int main(int argc, char** argv) {
     s.morphMs = 1e3 * report.morphSeconds;
     s.modesMs = 1e3 * report.modesSeconds;
     s.solves = report.solves;
+    if (check) {
+      // The options correctMorphed gives the morphed tets: unit stiffness, the mass the morph lacks as
+      // point masses or, where none, as density.
+      volume::ModalOptions unit = modal;
+      unit.material = core::unitMaterial(modal.material.poissonRatio);
+      if (!morphed->pointMasses.empty())
+        unit.pointMasses = morphed->pointMasses;
+      else
+        unit.material.density = report.massScale;
+      auto reference = volume::computeModes(morphed->tetMesh, unit);
+      if (!reference) {
+        std::fprintf(stderr, "%s: %s\n", record.name.c_str(), reference.error().message.c_str());
+        ++failed;
+        continue;
+      }
+      std::tie(s.frequencyError, s.shapeError) = modeDifference(corrected->physics.modes, *reference);
+    }
     byFamily[volume::toString(record.family)].push_back(s);
     all.push_back(s);
   }
   std::printf("%s: every %zu-th of %zu entries, %s tets, %d modes; %d failed\n\n", argv[1], every,
               entries.size(), volume::toString(modal.order), modal.modes, failed);
   std::printf(
-      "| family | entries | median tets | median dof | morph p50 (ms) | modes p50 | solves p50 | "
-      "correction p50 | correction p90 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| family | entries | median tets | median dof | morph p50 (ms) | modes p50 | solves p50 | solves mean "
+      "| "
+      "correction p50 | correction p90 |%s\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|%s\n",
+      check ? " frequencies, most off | shapes, most off (1 − MAC) |" : "", check ? "---:|---:|" : "");
   for (const auto& [family, samples] : byFamily)
-    printRow(family, samples);
-  printRow("**all**", all);
+    printRow(family, samples, check);
+  printRow("**all**", all, check);
   return failed == 0 ? 0 : 1;
 }
