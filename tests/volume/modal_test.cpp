@@ -260,15 +260,16 @@ TEST(Modal, SeededLanczosAgreesWithTheDenseSolverForRandomSeeds) {
       Result<core::ModalData> seeded = computeModesFrom(mesh, seeds, options, &solves);
       ASSERT_TRUE(seeded.ok()) << seeded.error().message;
       EXPECT_GT(solves, 0);
-      // Converged to a residual of 1e-6, so eigenvalues to ~1e-12 and isolated shapes to ~1e-6.
+      // Converged to a relative residual of 1e-4: eigenvalues to its square, ~1e-8, and the shapes of
+      // modes isolated by over 1 % to the residual over that gap, an angle of 1e-2 (1 − cos ≈ 5e-5) at most.
       for (int m = 0; m < 6; ++m) {
-        EXPECT_NEAR(seeded->eigenvalues[m] / dense->eigenvalues[m], 1.0, 1e-10)
+        EXPECT_NEAR(seeded->eigenvalues[m] / dense->eigenvalues[m], 1.0, 1e-8)
             << toString(order) << " trial " << trial << " mode " << m;
         const bool isolated = (m == 0 || dense->eigenvalues[m] > 1.01 * dense->eigenvalues[m - 1]) &&
                               (m == 5 || dense->eigenvalues[m + 1] > 1.01 * dense->eigenvalues[m]);
         if (!isolated) continue;
         const Eigen::VectorXd a = seeded->shapes.col(m), b = dense->shapes.col(m);
-        EXPECT_NEAR(std::abs(a.dot(b)) / (a.norm() * b.norm()), 1.0, 1e-6)
+        EXPECT_NEAR(std::abs(a.dot(b)) / (a.norm() * b.norm()), 1.0, 1e-4)
             << toString(order) << " trial " << trial << " mode " << m;
       }
     }
