@@ -3,8 +3,9 @@
 // its methods, simplicial and supernodal, with the one SparseCholesky's automatic choice takes (its
 // threshold depends on the processor and the BLAS loaded: Debian's alternatives choose it; LD_LIBRARY_PATH,
 // say /usr/lib/x86_64-linux-gnu/blis-serial:/usr/lib/x86_64-linux-gnu/lapack, overrides them). For one entry
-// of each family: the degrees of freedom, each solver's factorization, one solve, and one solve with 20
-// right-hand sides (milliseconds, best of three), and how far the automatic choice's solution is from
+// of each family: the degrees of freedom, each solver's factorization, one solve, one solve with 4
+// right-hand sides (CHOLMOD's: the seeded modal analysis's block) and one with 20 (milliseconds, best of
+// three), and how far the automatic choice's solution is from
 // Eigen's. Each factorization includes its analysis: Eigen's with its AMD on the scalar graph, CHOLMOD's
 // with the node-block order the modal analysis gives it. Run it on one core (taskset -c 0): the build
 // runs one factorization per core.
@@ -62,8 +63,9 @@ int main(int argc, char** argv) {
   }
   std::printf(
       "| entry | dof | Eigen simplicial: factor | solve | 20 solves | CHOLMOD simplicial: factor | solve "
-      "| 20 solves | CHOLMOD supernodal: factor | solve | 20 solves | automatic choice | relative "
-      "difference |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n");
+      "| 4 solves | 20 solves | CHOLMOD supernodal: factor | solve | 4 solves | 20 solves | automatic choice "
+      "| "
+      "relative difference |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n");
   std::map<std::string, int> taken;
   std::array<std::vector<double>, 2> blockRatio;  // over simplicial, over supernodal
   for (const io::EntryRecord& record : db->entries()) {
@@ -89,8 +91,9 @@ int main(int argc, char** argv) {
       volume::detail::SparseCholesky cholesky(method);
       const double f = bestOfThree([&] { cholesky.factorize(a, order); });
       const double s1 = bestOfThree([&] { x = cholesky.solve(Eigen::MatrixXd(b.col(0))); });
+      const double s4 = bestOfThree([&] { x = cholesky.solve(Eigen::MatrixXd(b.leftCols(4))); });
       const double m = bestOfThree([&] { x = cholesky.solve(b); });
-      std::printf(" | %.1f | %.2f | %.1f", f, s1, m);
+      std::printf(" | %.1f | %.2f | %.2f | %.1f", f, s1, s4, m);
       const std::size_t k = method == volume::detail::CholeskyMethod::kSupernodal ? 1 : 0;
       factor[k] = f;
       single[k] = s1;
