@@ -97,12 +97,14 @@ Result<core::ModalData> computeModes(const core::TetMesh& mesh, const ModalOptio
 Result<core::ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOptions& options = {});
 
 /// computeModes started from approximate modes: `seeds` (3·mesh.nodeCount() × s, the corners' values;
-/// s ≥ 1, typically the modes of a similar mesh, such as the entry a mesh was morphed from) start the
-/// Lanczos recurrence instead of a random vector. The same modes as computeModes, converged less far
+/// s ≥ 1, typically the modes of a similar mesh, such as the entry a mesh was morphed from) start a block
+/// Lanczos (four vectors a step, each a mixture of all the seeds; the restarted Lanczos of computeModes,
+/// from the seeds' sum, where the block's basis fills first). The same modes as computeModes, converged
+/// less far
 /// (Lanczos stops at a relative residual of 1e-4, computeModes at 1e-10; on the default catalog's entries
 /// the frequencies agree to ~1e-8 and the shapes, where the next frequency is over 1 % away, to ~1e-7),
-/// for fewer solves; the first vector matters little to Lanczos. `solves`, when given,
-/// receives the number of solves with the factorized K − σM. Errors: computeModes', and
+/// in less time. `solves`, when given, receives the number of solves with the factorized K − σM (one per
+/// vector of a block). Errors: computeModes', and
 /// kInvalidArgument for seeds of the wrong size or not finite.
 Result<core::ModalData> computeModesFrom(const core::TetMesh& mesh, const Eigen::MatrixXd& seeds,
                                          const ModalOptions& options, int* solves = nullptr);
