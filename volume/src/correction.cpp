@@ -128,22 +128,26 @@ bool betterMorph(const CorrectionReport& a, const CorrectionReport& b) {
   return a.morph.meanTargetDistance < b.morph.meanTargetDistance;
 }
 
+ModalOptions morphedModalOptions(const MorphedEntry& morphed, const ModalOptions& modal) {
+  ModalOptions unit = modal;
+  unit.material = core::unitMaterial(modal.material.poissonRatio);
+  if (!morphed.pointMasses.empty())
+    unit.pointMasses = morphed.pointMasses;
+  else
+    unit.material.density = morphed.report.massScale;
+  return unit;
+}
+
 Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEntry morphed,
                                       const ModalOptions& modal) {
   CorrectedEntry out;
   out.report = morphed.report;
   out.physics.tetMesh = std::move(morphed.tetMesh);
   out.physics.massProperties = core::computeTetMassProperties(out.physics.tetMesh, out.report.massScale);
-  const bool lumped = !morphed.pointMasses.empty();
 
   // The entry's modes on the same nodes are the seeds: the morph moved the nodes, not their numbering.
   const Clock::time_point start = Clock::now();
-  ModalOptions unit = modal;
-  unit.material = core::unitMaterial(modal.material.poissonRatio);
-  if (lumped)
-    unit.pointMasses = std::move(morphed.pointMasses);
-  else
-    unit.material.density = out.report.massScale;
+  const ModalOptions unit = morphedModalOptions(morphed, modal);
   auto modes = computeModesFrom(out.physics.tetMesh, entry.modes.shapes, unit, &out.report.solves);
   if (!modes) return withContext(modes.error(), "correction: modes on the morphed tets");
   out.physics.modes = std::move(modes).value();

@@ -116,9 +116,12 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const MorphTarg
 /// places it: after this, `morphed` is what morphEntry would have returned.
 void placeMissingMass(MorphedEntry& morphed, const MorphTarget::View& target);
 
-/// The correction's second half: the modes of `morphed` (morphEntry of this `entry`) computed with `modal`
-/// (the database's: count, elements, Poisson ratio; E = ρ = 1 and morphed.pointMasses, or ρ =
-/// report.massScale where there are none), seeded by the entry's modes; the entry's collision compound and
+/// The options the modes of `morphed` are computed with: `modal`'s (the database's: count, elements,
+/// Poisson ratio) with E = ρ = 1 and morphed.pointMasses, or ρ = report.massScale where there are none.
+ModalOptions morphedModalOptions(const MorphedEntry& morphed, const ModalOptions& modal);
+
+/// The correction's second half: the modes of `morphed` (morphEntry of this `entry`) computed with
+/// morphedModalOptions(morphed, modal), seeded by the entry's modes; the entry's collision compound and
 /// damping. Thread-safe. Errors: computeModesFrom's.
 Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEntry morphed,
                                       const ModalOptions& modal);
