@@ -619,8 +619,8 @@ Result<ModalData> modesOf(const SymmetricShiftInvert& op, const Pencil& pencil, 
 }
 
 /// Shift-invert Lanczos (Spectra's, restarted) on `op` to `tolerance` (a relative Ritz residual), from
-/// `start` (a vector of the pencil's space) when given, else Spectra's own random vector; `solves` counts
-/// the solves with the factorized K − σM.
+/// `start` (a vector of the pencil's space) when given, else Spectra's own random vector; the solves with
+/// the factorized K − σM are added to `solves`.
 Result<ModalData> restartedLanczos(SymmetricShiftInvert& op, const Pencil& pencil, const FemMatrices& fem,
                                    const ModalOptions& options, double tolerance,
                                    const Eigen::VectorXd* start, int* solves) {

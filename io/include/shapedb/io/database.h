@@ -152,8 +152,8 @@ struct QueryResult {
   /// several solids, or with cavities answered by a generated entry: the model was fitted on single solids
   /// without cavities (physics->warnings says which).
   std::optional<double> predictedFrequencyError;
-  std::size_t orientationCandidates =
-      0;  ///< orientations tried (the search skips those its index sees alike)
+  /// Orientations tried (the search skips those its index sees alike).
+  std::size_t orientationCandidates = 0;
   QueryTimes times;
 };
 
