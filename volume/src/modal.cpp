@@ -14,6 +14,7 @@
 #include <shapedb/volume/modal.h>
 
 #include "sparse_cholesky.h"
+#include "sparse_products.h"
 
 namespace shapedb::volume {
 namespace {
@@ -94,8 +95,7 @@ class SymmetricShiftInvert {
     const Eigen::Index n = rows(), k = x.cols();
     Eigen::MatrixXd s(n, k), ms(n, k), y(n, k);
     mSolver.solveFactorTransposed(x.data(), s.data(), k);
-    for (Eigen::Index j = 0; j < k; ++j)  // column by column: Eigen's product with a block is slower
-      ms.col(j).noalias() = mM * s.col(j);
+    detail::symmetricProduct(mM, s.data(), ms.data(), k);
     mSolver.solveFactor(ms.data(), y.data(), k);
     y.noalias() -= mRigid * (mRigid.transpose() * y);
     return y;
@@ -117,7 +117,7 @@ class SymmetricShiftInvert {
  private:
   /// H⁻¹ x = Hᵀ A x.
   Eigen::MatrixXd imageOf(const Eigen::MatrixXd& x) const {
-    const Eigen::MatrixXd ax = mShifted * x;
+    const Eigen::MatrixXd ax = detail::symmetricProduct(mShifted, x);
     Eigen::MatrixXd y(x.rows(), x.cols());
     mSolver.solveFactor(ax.data(), y.data(), x.cols());
     return y;
@@ -250,7 +250,7 @@ Result<ModalData> makeModalData(const Eigen::VectorXd& eigenvalues, const Eigen:
   data.shapes = vectors.leftCols(options.modes);
   // M-normalize explicitly (the solvers' own normalization is in their inner product, up to round-off),
   // and fix each sign so the largest component is positive: the same mesh gives the same bytes.
-  const Eigen::MatrixXd massShapes = fem.mass * data.shapes;
+  const Eigen::MatrixXd massShapes = detail::symmetricProduct(fem.mass, data.shapes);
   for (int i = 0; i < options.modes; ++i) {
     auto phi = data.shapes.col(i);
     phi /= std::sqrt(phi.dot(massShapes.col(i)));
@@ -602,7 +602,7 @@ struct Pencil {
 Pencil pencilOf(const std::vector<core::Vec3>& nodes, const FemMatrices& fem) {
   Pencil p;
   p.rigid = rigidMotions(nodes, fem.mass);
-  const Eigen::MatrixXd stiffRigid = fem.stiffness * p.rigid;
+  const Eigen::MatrixXd stiffRigid = detail::symmetricProduct(fem.stiffness, p.rigid);
   for (int j = 0; j < 6; ++j)
     p.rigidEigenvalues[static_cast<std::size_t>(j)] = p.rigid.col(j).dot(stiffRigid.col(j));
   const double scale = fem.stiffness.diagonal().sum() / fem.mass.diagonal().sum();
@@ -841,8 +841,9 @@ Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& s
   // Each seed M-normalized, so that every seed mode is well represented in the start (a zero seed stays
   // zero).
   const auto normalized = [](const FemMatrices& fem, Eigen::MatrixXd all) {
+    const Eigen::MatrixXd massAll = detail::symmetricProduct(fem.mass, all);
     for (Eigen::Index j = 0; j < all.cols(); ++j) {
-      const double norm = std::sqrt(all.col(j).dot(fem.mass * all.col(j)));
+      const double norm = std::sqrt(all.col(j).dot(massAll.col(j)));
       if (norm > 0.0) all.col(j) /= norm;
     }
     return all;
