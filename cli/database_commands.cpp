@@ -321,15 +321,24 @@ void printInfo(const std::string& path, const InfoSummary& s) {
   if (p.entry.tetgen.wallEdgeFraction > 0.0)
     std::snprintf(wallBound, sizeof wallBound, " (edges ≤ %.3g of the wall thickness)",
                   p.entry.tetgen.wallEdgeFraction);
+  // Families with a volume bound of their own: "(stone ≤ 0.03)".
+  std::string ownBounds;
+  for (const auto& [family, fraction] : p.volumeFractions) {
+    char bound[64];
+    std::snprintf(bound, sizeof bound, "%s%s ≤ %.3g", ownBounds.empty() ? " (" : ", ",
+                  volume::toString(family), fraction);
+    ownBounds += bound;
+  }
+  if (!ownBounds.empty()) ownBounds += ")";
   std::printf(
       "parameters: catalog of %zu, descriptor grid %d (%s sampling), %d modes at Poisson ratio %.3g\n"
-      "  on %s tets, TetGen q%.3g with tets ≤ 1/%.0f of the volume%s, collision ≤ %d shapes,\n"
+      "  on %s tets, TetGen q%.3g with tets ≤ 1/%.0f of the volume%s%s, collision ≤ %d shapes,\n"
       "  Rayleigh α %.3g β %.3g\n",
       p.entries, p.entry.descriptor.gridSize, core::toString(p.entry.descriptor.sampling),
       p.entry.modal.modes, p.entry.modal.material.poissonRatio, volume::toString(p.entry.modal.order),
       p.entry.tetgen.maxRadiusEdgeRatio,
-      p.entry.tetgen.maxVolumeFraction > 0 ? 1.0 / p.entry.tetgen.maxVolumeFraction : 0.0, wallBound,
-      p.entry.collision.maxShapes, p.entry.damping.alpha, p.entry.damping.beta);
+      p.entry.tetgen.maxVolumeFraction > 0 ? 1.0 / p.entry.tetgen.maxVolumeFraction : 0.0, ownBounds.c_str(),
+      wallBound, p.entry.collision.maxShapes, p.entry.damping.alpha, p.entry.damping.beta);
   if (s.check) printCheck(*s.check);
 }
 

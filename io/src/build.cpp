@@ -53,6 +53,12 @@ Status validateParameters(const BuildParameters& p) {
     return Error{ErrorCode::kInvalidArgument, "the stones' subdivisions must be " +
                                                   std::to_string(volume::kMinStoneSubdivisions) + " to " +
                                                   std::to_string(volume::kMaxStoneSubdivisions)};
+  if (p.resolution.unionTrianglesPerSegment < 1)
+    return Error{ErrorCode::kInvalidArgument, "the unions' triangles per segment must be at least 1"};
+  for (const auto& [family, fraction] : p.volumeFractions)
+    if (!validVolumeFraction(fraction))
+      return Error{ErrorCode::kInvalidArgument, std::string("the volume bound of the ") +
+                                                    volume::toString(family) + " family must be in (0, 1]"};
   return Ok{};
 }
 
@@ -103,7 +109,8 @@ ComputedEntry computeCatalogEntry(const std::vector<volume::ShapeSpec>& catalog,
   c.record.family = spec.family;
   c.record.params = spec.params;
   auto mesh = volume::makeFamilyShape(spec, p.resolution);
-  auto data = mesh ? volume::computeEntry(*mesh, p.entry) : Result<volume::EntryData>(mesh.error());
+  auto data = mesh ? volume::computeEntry(*mesh, entryOptionsFor(p, spec.family))
+                   : Result<volume::EntryData>(mesh.error());
   if (!data) {
     c.failure = FailureRecord{c.record.name, data.error().message};
     return c;

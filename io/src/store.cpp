@@ -114,14 +114,30 @@ volume::StageTimes timesFromJson(const json& j) {
 
 volume::ShapeResolution entryResolution(volume::ElementOrder order) {
   return order == volume::ElementOrder::kQuadratic
-             ? volume::ShapeResolution{.segments = 12, .stacks = 6, .stoneSubdivisions = 1}
+             ? volume::ShapeResolution{.segments = 12,
+                                       .stacks = 6,
+                                       .unionTrianglesPerSegment = 12,
+                                       .stoneSubdivisions = 1}
              : volume::ShapeResolution{.segments = 24, .stacks = 12, .stoneSubdivisions = 2};
+}
+
+FamilyVolumeFractions entryVolumeFractions(volume::ElementOrder order) {
+  if (order == volume::ElementOrder::kQuadratic) return {{volume::Family::kStone, 3.0 / 100.0}};
+  return {};
 }
 
 BuildParameters withElements(BuildParameters parameters, volume::ElementOrder order) {
   parameters.entry = volume::withElements(parameters.entry, order);
   parameters.resolution = entryResolution(order);
+  parameters.volumeFractions = entryVolumeFractions(order);
   return parameters;
+}
+
+volume::EntryOptions entryOptionsFor(const BuildParameters& parameters, volume::Family family) {
+  volume::EntryOptions options = parameters.entry;
+  if (const auto own = parameters.volumeFractions.find(family); own != parameters.volumeFractions.end())
+    options.tetgen.maxVolumeFraction = own->second;
+  return options;
 }
 
 std::string toJson(const BuildParameters& p) {
@@ -129,6 +145,9 @@ std::string toJson(const BuildParameters& p) {
   json families = json::array();
   for (volume::Family f : p.families)
     families.push_back(volume::toString(f));
+  json volumeFractions = json::object();
+  for (const auto& [family, fraction] : p.volumeFractions)
+    volumeFractions[volume::toString(family)] = fraction;
   const json j = {
       {"entries", p.entries},
       {"families", families},
@@ -136,7 +155,8 @@ std::string toJson(const BuildParameters& p) {
       {"resolution",
        {{"segments", p.resolution.segments},
         {"stacks", p.resolution.stacks},
-        {"stone_subdivisions", p.resolution.stoneSubdivisions}}},
+        {"stone_subdivisions", p.resolution.stoneSubdivisions},
+        {"union_triangles_per_segment", p.resolution.unionTrianglesPerSegment}}},
       {"descriptor",
        {{"grid", e.descriptor.gridSize},
         {"sampling", core::toString(e.descriptor.sampling)},
@@ -144,7 +164,8 @@ std::string toJson(const BuildParameters& p) {
       {"tetgen",
        {{"max_radius_edge_ratio", e.tetgen.maxRadiusEdgeRatio},
         {"max_volume_fraction", e.tetgen.maxVolumeFraction},
-        {"wall_edge_fraction", e.tetgen.wallEdgeFraction}}},
+        {"wall_edge_fraction", e.tetgen.wallEdgeFraction},
+        {"family_volume_fractions", volumeFractions}}},
       {"modes",
        {{"count", e.modal.modes},
         {"poisson_ratio", e.modal.material.poissonRatio},
@@ -184,6 +205,10 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
       return Error{ErrorCode::kParse, "the build parameters' stone subdivisions must be " +
                                           std::to_string(volume::kMinStoneSubdivisions) + " to " +
                                           std::to_string(volume::kMaxStoneSubdivisions)};
+    // Files from before the unions' own triangle count made them from 20 triangles a segment.
+    p.resolution.unionTrianglesPerSegment = j.at("resolution").value("union_triangles_per_segment", 20);
+    if (p.resolution.unionTrianglesPerSegment < 1)
+      return Error{ErrorCode::kParse, "the build parameters' union triangles per segment must be ≥ 1"};
     volume::EntryOptions& e = p.entry;
     e.descriptor.gridSize = j.at("descriptor").at("grid").get<int>();
     if (e.descriptor.gridSize < 2 || e.descriptor.gridSize > core::kMaxGridSize)
@@ -200,6 +225,19 @@ Result<BuildParameters> parseBuildParameters(const std::string& text) {
     e.tetgen.wallEdgeFraction = j.at("tetgen").value("wall_edge_fraction", 0.0);
     if (!(e.tetgen.wallEdgeFraction >= 0.0 && std::isfinite(e.tetgen.wallEdgeFraction)))
       return Error{ErrorCode::kParse, "the build parameters' wall edge fraction must be finite and ≥ 0"};
+    // Files from before the families' own volume bounds mesh every family at the entries'.
+    p.volumeFractions.clear();
+    if (const auto own = j.at("tetgen").find("family_volume_fractions"); own != j.at("tetgen").end())
+      for (const auto& [name, fraction] : own->items()) {
+        const auto family = volume::parseFamily(name);
+        if (!family)
+          return Error{ErrorCode::kParse,
+                       "unknown family '" + name + "' in the build parameters' volume bounds"};
+        if (!validVolumeFraction(fraction.get<double>()))
+          return Error{ErrorCode::kParse,
+                       "the build parameters' volume bound of the " + name + " family must be in (0, 1]"};
+        p.volumeFractions[*family] = fraction.get<double>();
+      }
     e.modal.modes = j.at("modes").at("count").get<int>();
     e.modal.material.poissonRatio = j.at("modes").at("poisson_ratio").get<double>();
     // Files from before quadratic tets have no "elements": theirs are linear.

@@ -829,6 +829,41 @@ TEST(BuildParametersJson, StoneSubdivisionsRoundTripAndOlderFilesHaveTwo) {
   EXPECT_NE(back.error().message.find("stone subdivisions"), std::string::npos) << back.error().message;
 }
 
+TEST(BuildParametersJson, FamiliesOwnMeshingRoundTripsAndOlderFilesHaveNone) {
+  BuildParameters quadratic = withElements(BuildParameters{}, volume::ElementOrder::kQuadratic);
+  quadratic.families = {volume::Family::kStone, volume::Family::kUnion};
+  EXPECT_EQ(quadratic.resolution.unionTrianglesPerSegment, 12);
+  EXPECT_EQ(quadratic.volumeFractions.at(volume::Family::kStone), 3.0 / 100.0);
+  const BuildParameters linear = withElements(quadratic, volume::ElementOrder::kLinear);
+  EXPECT_EQ(linear.resolution.unionTrianglesPerSegment, 20);
+  EXPECT_TRUE(linear.volumeFractions.empty());
+  Result<BuildParameters> back = parseBuildParameters(toJson(quadratic));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->resolution.unionTrianglesPerSegment, 12);
+  EXPECT_EQ(back->volumeFractions, quadratic.volumeFractions);
+  EXPECT_EQ(toJson(*back), toJson(quadratic));
+
+  // A file written before these were stored made its unions from 20 triangles a segment and meshed every
+  // family at the entries' bound: a resumed build of it makes the rest the same way.
+  nlohmann::json older = nlohmann::json::parse(toJson(quadratic));
+  older["resolution"].erase("union_triangles_per_segment");
+  older["tetgen"].erase("family_volume_fractions");
+  back = parseBuildParameters(older.dump());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->resolution.unionTrianglesPerSegment, 20);
+  EXPECT_TRUE(back->volumeFractions.empty());
+  EXPECT_EQ(entryOptionsFor(*back, volume::Family::kStone).tetgen.maxVolumeFraction, 1.0 / 100.0);
+
+  older["tetgen"]["family_volume_fractions"] = {{"pebble", 0.03}};
+  back = parseBuildParameters(older.dump());
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().message.find("pebble"), std::string::npos) << back.error().message;
+  older["tetgen"]["family_volume_fractions"] = {{"stone", 0.0}};
+  back = parseBuildParameters(older.dump());
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().message.find("stone"), std::string::npos) << back.error().message;
+}
+
 TEST(BuildParametersJson, TheWallBoundRoundTripsAndOlderFilesHaveNone) {
   BuildParameters walled;
   walled.families = {volume::Family::kBeam};
@@ -1086,6 +1121,28 @@ TEST(Database, CavitiesAndSeparateSolidsAreSaidAndLearnedObjectsKeepTheirCavitie
 
 namespace shapedb::io {
 namespace {
+
+// A family with a volume bound of its own is meshed with it, and the others with the entries' bound.
+TEST(BuildCatalog, AFamilyWithItsOwnVolumeBoundIsMeshedWithIt) {
+  BuildParameters p;
+  p.entries = 2;
+  p.families = {volume::Family::kStone, volume::Family::kBox};
+  p.entry.modal.modes = 4;
+  ASSERT_EQ(p.volumeFractions.count(volume::Family::kStone), 1u) << "the default build meshes stones coarser";
+  const std::vector<volume::ShapeSpec> catalog = volume::buildCatalog(p.entries, p.families);
+  ASSERT_EQ(catalog[0].family, volume::Family::kStone);
+  BuildParameters even = p;
+  even.volumeFractions.clear();
+  const detail::ComputedEntry own = detail::computeCatalogEntry(catalog, 0, p);
+  const detail::ComputedEntry shared = detail::computeCatalogEntry(catalog, 0, even);
+  ASSERT_TRUE(own.data && shared.data);
+  EXPECT_LT(own.record.tets, shared.record.tets);
+  // The bound is the stones': a box is meshed alike either way.
+  const detail::ComputedEntry box = detail::computeCatalogEntry(catalog, 1, p);
+  const detail::ComputedEntry sameBox = detail::computeCatalogEntry(catalog, 1, even);
+  ASSERT_TRUE(box.data && sameBox.data);
+  EXPECT_EQ(box.data->physics, sameBox.data->physics);
+}
 
 // A computed entry crosses from the rank that computed it to the one that writes as bytes: they must carry
 // the blobs unchanged (the file gets the single build's bytes), a failure with its reason, and nothing that

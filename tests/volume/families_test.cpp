@@ -74,6 +74,22 @@ TEST(Families, ALevelSetShapeNeverPassesThroughItself) {
   EXPECT_TRUE(meshed.ok()) << spec.name() << ": " << meshed.error().message;
 }
 
+// A union's surface is simplified to its own triangle budget (ShapeResolution::unionTrianglesPerSegment),
+// as far as keeping it one closed solid allows; a smaller budget never gives more triangles.
+TEST(Families, AUnionIsSimplifiedToItsOwnTriangleBudget) {
+  std::size_t fewer = 0;
+  for (std::uint32_t i = 0; i < 6; ++i) {
+    const ShapeSpec spec = familySpec(Family::kUnion, i);
+    auto coarse = makeFamilyShape(spec, {.segments = 12, .unionTrianglesPerSegment = 12});
+    auto fine = makeFamilyShape(spec, {.segments = 12, .unionTrianglesPerSegment = 20});
+    ASSERT_TRUE(coarse.ok() && fine.ok()) << spec.name();
+    EXPECT_TRUE(core::requireClosedOriented(core::analyzeTopology(*coarse)).ok()) << spec.name();
+    EXPECT_LE(coarse->triangles.size(), fine->triangles.size()) << spec.name();
+    fewer += coarse->triangles.size() < fine->triangles.size() ? 1 : 0;
+  }
+  EXPECT_GT(fewer, 0u) << "the budget made no union coarser";
+}
+
 // The holes of a handle, a hook's gap, a tube's bore: what makes these families non-convex is there. A
 // ring and a tube are of genus 1 (Euler characteristic 0), a plate with n holes of genus n; the others
 // of genus 0 but for unions and limbed bodies, whose limbs may close loops.

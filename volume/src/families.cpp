@@ -427,8 +427,8 @@ std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family>
 Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolution& resolution) {
   const double a = spec.params.x(), b = spec.params.y();
   const int segments = std::max(3, resolution.segments), stacks = std::max(2, resolution.stacks);
-  const auto maxTriangles =
-      static_cast<std::size_t>(std::max(100, segments * resolution.trianglesPerSegment));
+  const auto unionTriangles =
+      static_cast<std::size_t>(std::max(100, segments * resolution.unionTrianglesPerSegment));
   // Thin walls and limbs, which a correction bends into other shapes, keep the resolution of 16
   // segments at least (docs/accuracy.md: at 12, shells' median error passed 2 % and limbs' worst 5 %).
   constexpr int kThinSegments = 16;
@@ -472,7 +472,7 @@ Result<TriangleMesh> makeFamilyShape(const ShapeSpec& spec, const ShapeResolutio
       return detail::makeLimbedShape(static_cast<int>(a), b, spec.params.z(), rng,
                                      static_cast<std::size_t>(thinSegments * resolution.trianglesPerSegment));
     case Family::kUnion:
-      return detail::makeUnionShape(static_cast<int>(a), rng, maxTriangles);
+      return detail::makeUnionShape(static_cast<int>(a), rng, unionTriangles);
     case Family::kUser:
     case Family::kLearned:
       break;

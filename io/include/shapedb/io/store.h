@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -30,12 +31,31 @@ inline constexpr int kSchemaVersion = 1;
 /// and limbs need. Linear: 24 and 12, as databases of linear tets have always been built.
 volume::ShapeResolution entryResolution(volume::ElementOrder order);
 
+/// A family's own TetGen volume bound: its tets' largest share of the solid's volume, in place of the
+/// entry options' (volume::TetrahedralizeOptions::maxVolumeFraction).
+using FamilyVolumeFractions = std::map<volume::Family, double>;
+
+/// The families meshed coarser than the rest for entries of `order` elements. Quadratic: stones at 3/100
+/// (the others at 1/100). A stone is compact and smooth: at 1/100 six of them were within 0.7 % of the
+/// same surfaces meshed three times finer, far inside the aim of 2 % (median) and 5 % (worst) the other
+/// families are held to; at 3/100 they have about half the tets and are within 1.4 %, and a correction
+/// that morphs one takes about half the time (docs/accuracy.md). Linear: none.
+FamilyVolumeFractions entryVolumeFractions(volume::ElementOrder order);
+
+/// A volume bound a family may have: a share of the solid's volume in (0, 1].
+inline bool validVolumeFraction(double fraction) {
+  return fraction > 0.0 && fraction <= 1.0;
+}
+
 /// What a database was built with. Stored in the file; every entry of a file shares them. The defaults
 /// are those of `shapedb build`: quadratic tets (withElements).
 struct BuildParameters {
   volume::EntryOptions entry;
   /// Surface resolution of the curved families (entryResolution of the entry's elements).
   volume::ShapeResolution resolution = entryResolution(volume::ElementOrder::kQuadratic);
+  /// Families meshed with a volume bound of their own (entryVolumeFractions of the entry's elements);
+  /// entries of the others, and user and learned entries, take entry.tetgen's.
+  FamilyVolumeFractions volumeFractions = entryVolumeFractions(volume::ElementOrder::kQuadratic);
   std::vector<volume::Family> families;  ///< of the generated catalog
   /// Each family's share of the catalog (volume::buildCatalog), as many as families; empty: even (the
   /// files built before weights existed).
@@ -44,8 +64,13 @@ struct BuildParameters {
 };
 
 /// `parameters` for a database of `order` elements: the entry's elements and TetGen bounds
-/// (volume::withElements) and the surface resolution that goes with them (entryResolution).
+/// (volume::withElements), and the surface resolution and families' volume bounds that go with them
+/// (entryResolution, entryVolumeFractions).
 BuildParameters withElements(BuildParameters parameters, volume::ElementOrder order);
+
+/// The options an entry of `family` is computed with: `parameters.entry`, with the family's own volume
+/// bound if it has one.
+volume::EntryOptions entryOptionsFor(const BuildParameters& parameters, volume::Family family);
 
 /// The parameters as JSON text (stored in the file's meta table), and back.
 std::string toJson(const BuildParameters& parameters);

@@ -134,8 +134,14 @@ std::vector<ShapeSpec> buildCatalog(std::size_t entries, std::span<const Family>
 struct ShapeResolution {
   int segments = 24;  ///< around the axis (cylinder, cone, capsule, ellipsoid; a ring's or rod's section)
   int stacks = 12;    ///< pole to pole (ellipsoid); capsule caps get half each
-  /// Triangles of the families made from level sets (limbed, union) per segment.
+  /// Triangles of a limbed body's level-set surface per segment (of at least 16: its limbs need them).
   int trianglesPerSegment = 20;
+  /// Triangles of a union's level-set surface per segment, at least 100 in all. TetGen meshes a union
+  /// from its surface inward, about ten tets a surface triangle at the quadratic build's bounds: 12 a
+  /// segment (the quadratic catalog's; 144 triangles at 12 segments) gave six unions a third fewer tets
+  /// than 20, their frequencies still within 2.1 % of the same surfaces meshed three times finer
+  /// (docs/accuracy.md).
+  int unionTrianglesPerSegment = 20;
   /// Subdivisions of the icosahedron a stone is made from (1: 80 triangles; 2: 320; each level four
   /// times the last; validStoneSubdivisions). Its waves are smooth, and 80 triangles keep a stone's
   /// frequencies within 1 % of its meshing three times finer for half the tets of 320 (docs/accuracy.md).
