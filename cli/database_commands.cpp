@@ -321,19 +321,23 @@ void printInfo(const std::string& path, const InfoSummary& s) {
   if (p.entry.tetgen.wallEdgeFraction > 0.0)
     std::snprintf(wallBound, sizeof wallBound, " (edges ≤ %.3g of the wall thickness)",
                   p.entry.tetgen.wallEdgeFraction);
-  // Families with a volume bound of their own: "(stone ≤ 0.03)".
-  std::string ownBounds;
+  // Families with a volume bound of their own, those of one bound together: "(ring, stone ≤ 0.03)".
+  std::map<double, std::string> byBound;
   for (const auto& [family, fraction] : p.volumeFractions) {
-    char bound[64];
-    std::snprintf(bound, sizeof bound, "%s%s ≤ %.3g", ownBounds.empty() ? " (" : ", ",
-                  volume::toString(family), fraction);
-    ownBounds += bound;
+    std::string& names = byBound[fraction];
+    names += (names.empty() ? "" : ", ") + std::string(volume::toString(family));
+  }
+  std::string ownBounds;
+  for (const auto& [fraction, names] : byBound) {
+    char bound[32];
+    std::snprintf(bound, sizeof bound, " ≤ %.3g", fraction);
+    ownBounds += (ownBounds.empty() ? " (" : "; ") + names + bound;
   }
   if (!ownBounds.empty()) ownBounds += ")";
   std::printf(
       "parameters: catalog of %zu, descriptor grid %d (%s sampling), %d modes at Poisson ratio %.3g\n"
-      "  on %s tets, TetGen q%.3g with tets ≤ 1/%.0f of the volume%s%s, collision ≤ %d shapes,\n"
-      "  Rayleigh α %.3g β %.3g\n",
+      "  on %s tets, TetGen q%.3g with tets ≤ 1/%.0f of the volume%s%s,\n"
+      "  collision ≤ %d shapes, Rayleigh α %.3g β %.3g\n",
       p.entries, p.entry.descriptor.gridSize, core::toString(p.entry.descriptor.sampling),
       p.entry.modal.modes, p.entry.modal.material.poissonRatio, volume::toString(p.entry.modal.order),
       p.entry.tetgen.maxRadiusEdgeRatio,
