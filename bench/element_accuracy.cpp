@@ -4,12 +4,14 @@
 // elements. Prints one row per entry and a table per family (median and worst relative error over the five
 // frequencies), with the mean wall time of an entry's tetrahedralization and modes at the build's meshing.
 //   build/release/bin/element_accuracy [--per-family N] [--elements linear|quadratic]
-//       [--quality Q] [--volume-fraction F] [--wall-fraction W] [--reference-wall-fraction R]
+//       [--quality Q] [--volume-fraction F] [--family-volume-fraction FAMILY=F]
+//       [--wall-fraction W] [--reference-wall-fraction R]
 //       [--segments S] [--stacks T] [--union-triangles-per-segment U] [--stone-subdivisions K]
 //       [--modes M] [--families LIST] [--csv FILE]
 // Defaults: 6 entries per family spread over the default catalog's sweep, the default build's elements and
-// TetGen bounds (the families' own volume bounds too, unless --volume-fraction sets one for all), 20 modes
-// (the time a build pays), the default families.
+// TetGen bounds (the families' own volume bounds too, unless --volume-fraction sets one for all; after it,
+// --family-volume-fraction gives a family one of its own, measured against the same reference as the
+// others), 20 modes (the time a build pays), the default families.
 
 #include <algorithm>
 #include <chrono>
@@ -75,6 +77,15 @@ int main(int argc, char** argv) {
     } else if (arg == "--volume-fraction" && value) {
       options.tetgen.maxVolumeFraction = std::atof(argv[++i]);
       volumeFractions.clear();
+    } else if (arg == "--family-volume-fraction" && value) {
+      // FAMILY=F: that family's own volume bound, as BuildParameters::volumeFractions gives one.
+      const std::string pair = argv[++i];
+      const std::size_t at = pair.find('=');
+      const auto family = volume::parseFamily(pair.substr(0, at));
+      const double fraction = at == std::string::npos ? 0.0 : std::atof(pair.c_str() + at + 1);
+      if (!family || !io::validVolumeFraction(fraction))
+        return std::fprintf(stderr, "--family-volume-fraction takes FAMILY=F, F in (0, 1]\n"), 2;
+      volumeFractions[*family] = fraction;
     } else if (arg == "--wall-fraction" && value) {
       options.tetgen.wallEdgeFraction = std::atof(argv[++i]);
     } else if (arg == "--reference-wall-fraction" && value) {
@@ -98,7 +109,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: %s [--per-family N] [--elements linear|quadratic] [--quality Q]\n"
-                   "       [--volume-fraction F] [--wall-fraction W] [--reference-wall-fraction R]\n"
+                   "       [--volume-fraction F] [--family-volume-fraction FAMILY=F]\n"
+                   "       [--wall-fraction W] [--reference-wall-fraction R]\n"
                    "       [--segments S] [--stacks T] [--union-triangles-per-segment U]\n"
                    "       [--stone-subdivisions K] [--modes M]\n"
                    "       [--families LIST] [--csv FILE]\n",
