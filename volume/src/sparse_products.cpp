@@ -1,6 +1,7 @@
 #include "sparse_products.h"
 
 #include <algorithm>
+#include <array>
 #include <vector>
 
 namespace shapedb::volume::detail {
@@ -39,34 +40,16 @@ void productOfColumns(const Eigen::SparseMatrix<double>& a, const double* x, dou
 void symmetricProduct(const Eigen::SparseMatrix<double>& a, const double* x, double* y,
                       Eigen::Index columns) {
   // Eight columns at a time at most: their rows (64 bytes each) and the sums stay in registers and cache.
+  using Kernel = void (*)(const Eigen::SparseMatrix<double>&, const double*, double*, Eigen::Index,
+                          std::vector<double>&);
+  static constexpr std::array<Kernel, 8> kKernels{
+      &productOfColumns<1>, &productOfColumns<2>, &productOfColumns<3>, &productOfColumns<4>,
+      &productOfColumns<5>, &productOfColumns<6>, &productOfColumns<7>, &productOfColumns<8>};
   std::vector<double> rows;
-  Eigen::Index first = 0;
-  for (; first + 8 <= columns; first += 8)
-    productOfColumns<8>(a, x, y, first, rows);
-  switch (columns - first) {
-    case 7:
-      productOfColumns<7>(a, x, y, first, rows);
-      break;
-    case 6:
-      productOfColumns<6>(a, x, y, first, rows);
-      break;
-    case 5:
-      productOfColumns<5>(a, x, y, first, rows);
-      break;
-    case 4:
-      productOfColumns<4>(a, x, y, first, rows);
-      break;
-    case 3:
-      productOfColumns<3>(a, x, y, first, rows);
-      break;
-    case 2:
-      productOfColumns<2>(a, x, y, first, rows);
-      break;
-    case 1:
-      productOfColumns<1>(a, x, y, first, rows);
-      break;
-    default:
-      break;
+  for (Eigen::Index first = 0; first < columns;) {
+    const Eigen::Index width = std::min<Eigen::Index>(8, columns - first);
+    kKernels[static_cast<std::size_t>(width - 1)](a, x, y, first, rows);
+    first += width;
   }
 }
 
