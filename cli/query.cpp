@@ -167,8 +167,9 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
                 p.collision.overshoot);
     const Eigen::VectorXd hz = p.frequenciesHz();
     if (r.predictedFrequencyError)
-      std::printf("    predicted first-frequency error: about %.0f %% (from the fidelity report)\n",
-                  100.0 * *r.predictedFrequencyError);
+      std::printf("    predicted first-frequency error: about %.0f %% (from %s)\n",
+                  100.0 * *r.predictedFrequencyError,
+                  r.correction ? "the correction's morph and the fidelity report" : "the fidelity report");
     std::printf("    frequencies (Hz):");
     for (Eigen::Index i = 0; i < std::min<Eigen::Index>(hz.size(), 8); ++i)
       std::printf(" %.5g", hz[i]);
@@ -650,7 +651,8 @@ Command addQueryCommand(CLI::App& parent) {
                 "report both answers. JSON gains \"learned\" and \"after_learning\" per mesh");
   app->add_option("--enrich-above", o->enrichAbove,
                   "With --enrich: learn only the meshes whose answer's predicted first-frequency error\n"
-                  "(predicted_frequency_error, from the fidelity report) is above this fraction; 0: all")
+                  "(predicted_frequency_error: from the fidelity report, and with --correct from the\n"
+                  "correction's morph too) is above this fraction; 0: all")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0))
       ->needs(app->get_option("--enrich"));
