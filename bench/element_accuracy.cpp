@@ -136,6 +136,11 @@ int main(int argc, char** argv) {
   for (const auto& [family, fraction] : volumeFractions)
     std::printf("  %s: tets ≤ %g of the volume\n", volume::toString(family), fraction);
 
+  // Each family's entries are meshed as the build meshes them: these options, with its own volume bound.
+  io::BuildParameters meshing;
+  meshing.entry = options;
+  meshing.volumeFractions = volumeFractions;
+
   // Samples spread over each family's sweep as far as the default catalog takes it.
   const volume::FamilyMix mix = volume::defaultFamilyMix();
   const auto catalog = volume::buildCatalog(defaults.entries, mix.families, mix.weights);
@@ -156,10 +161,7 @@ int main(int argc, char** argv) {
         rows.push_back(row);
         continue;
       }
-      volume::EntryOptions own = options;
-      if (const auto bound = volumeFractions.find(family); bound != volumeFractions.end())
-        own.tetgen.maxVolumeFraction = bound->second;
-      auto entry = volume::computeEntry(*surface, own);
+      auto entry = volume::computeEntry(*surface, io::entryOptionsFor(meshing, family));
       auto fine = entry ? volume::computeEntry(*surface, reference) : entry;
       if (!entry || !fine) {
         row.error = (!entry ? entry : fine).error().message;
