@@ -587,7 +587,13 @@ Vec3 SurfaceSide::faceNormal(std::uint32_t triangle) const {
 }
 
 double SurfaceSide::signedDistance(const Vec3& p) const {
-  const ClosestPointTree::Hit hit = mTree.closest(p);
+  std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+  return signedDistance(p, none);
+}
+
+double SurfaceSide::signedDistance(const Vec3& p, std::uint32_t& near) const {
+  const ClosestPointTree::Hit hit = mTree.closest(p, near);
+  near = hit.triangle;
   // closestPointOnTriangle gives exact zeros outside the face's own Voronoi region: one zero, an edge;
   // two, a corner.
   const std::array<double, 3>& b = hit.closest.barycentric;

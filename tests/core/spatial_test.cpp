@@ -209,12 +209,22 @@ void expectSidesAgreeWithWindingNumber(const TriangleMesh& surface, std::mt19937
     points.push_back((i % 2 ? corner : edge) + near * Vec3(jitter(rng), jitter(rng), jitter(rng)));
   }
   int insides = 0;
+  // Every other search started from the triangle found for the point before, an unrelated one: the start
+  // must not change the answer.
+  std::uint32_t hint = std::numeric_limits<std::uint32_t>::max();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const double winding = windingNumber(surface, points[i]);
     ASSERT_LT(std::min(std::abs(winding), std::abs(winding - 1.0)), 1e-6) << "point " << i;
     ASSERT_EQ(side.inside(points[i]), winding > 0.5) << "point " << i << ", winding " << winding;
-    ASSERT_NEAR(std::abs(side.signedDistance(points[i])),
-                std::sqrt(tree.closest(points[i]).closest.squaredDistance), 1e-12);
+    const double distance = std::sqrt(tree.closest(points[i]).closest.squaredDistance);
+    ASSERT_NEAR(std::abs(side.signedDistance(points[i])), distance, 1e-12);
+    if (i % 2 == 1) {
+      const double started = side.signedDistance(points[i], hint);
+      ASSERT_EQ((started < 0.0), (winding > 0.5)) << "point " << i << ", started from a hint";
+      ASSERT_NEAR(std::abs(started), distance, 1e-12);
+    } else {
+      static_cast<void>(side.signedDistance(points[i], hint));  // sets `hint` for the next point
+    }
     insides += winding > 0.5;
   }
   // Both sides were tried, near the surface as well as far from it.

@@ -45,12 +45,13 @@ std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::Vi
 // of theirs.
 double strayShare(const core::TetMesh& tets, const MorphTarget::View& target) {
   double outside = 0.0, total = 0.0;
+  std::uint32_t near = MorphTarget::kNoHint;  // the previous tet's: tets numbered near are mostly near
   for (std::size_t t = 0; t < tets.tetCount(); ++t) {
     const core::Vec3 centroid = 0.25 * (tets.nodes[tets.tets[t][0]] + tets.nodes[tets.tets[t][1]] +
                                         tets.nodes[tets.tets[t][2]] + tets.nodes[tets.tets[t][3]]);
     const double volume = std::abs(core::tetVolume(tets, t));
     total += volume;
-    if (!target.inside(centroid)) outside += volume;
+    if (!target.inside(centroid, near)) outside += volume;
   }
   return total > 0.0 ? outside / total : 0.0;
 }

@@ -95,9 +95,12 @@ std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh)
 /// Elastic registration (the non-rigid ICP of Amberg et al. 2007, on a tet mesh): rounds of correspondences
 /// both ways, then the total displacement U that minimizes Uᵀ K U + w Σ (fit terms), K the mesh-motion
 /// stiffness of the start configuration, w growing round by round. A round whose displacement would push a
-/// tet under `minQuality` is taken in part (halved up to three times) or not at all.
+/// tet under `minQuality` is taken in part (halved up to three times) or not at all. `nearest` holds, per
+/// boundary node, the target triangle its closest point was last found on (MorphTarget::kNoHint before
+/// the first search): each search starts from it, as a node moves little from round to round.
 void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTarget::View& target, int rounds,
-                         double minQuality, detail::MotionStiffness& stiffness) {
+                         double minQuality, detail::MotionStiffness& stiffness,
+                         std::vector<std::uint32_t>& nearest) {
   if (rounds <= 0) return;
   const TetMesh start = mesh;
   const SparseMatrix k = stiffness.assemble(start);
@@ -116,6 +119,9 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
   const std::vector<int> order = detail::nodeBlockOrder(k);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
   SparseMatrix a = k;
+  // Per target point, the boundary face its closest point was last found on: the faces keep their
+  // numbering from round to round.
+  std::vector<std::uint32_t> onBoundary((target.vertexCount() + stride - 1) / stride, MorphTarget::kNoHint);
   for (int round = 0; round < rounds; ++round) {
     // From stiff (the fit moves the body nearly as a whole) to close: w from 0.1 to 100 times the
     // stiffness, in equal ratios.
@@ -148,7 +154,9 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
     for (std::size_t b = 0; b < boundary.nodes.size(); ++b) {
       const std::uint32_t node = boundary.nodes[b];
       const double one = 1.0;
-      addPoint({&node, 1}, {&one, 1}, target.closestPoint(mesh.nodes[node]), w * nodeArea[b]);
+      // Before the first search, the previous node's triangle: nodes numbered near are mostly near.
+      if (nearest[b] == MorphTarget::kNoHint && b > 0) nearest[b] = nearest[b - 1];
+      addPoint({&node, 1}, {&one, 1}, target.closestPoint(mesh.nodes[node], nearest[b]), w * nodeArea[b]);
     }
     // Target points to their closest boundary points (a face of the current boundary, by barycentric
     // weights).
@@ -160,9 +168,11 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
       return surface;
     }();
     const core::ClosestPointTree currentTree(current);
-    for (std::size_t v = 0; v < target.vertexCount(); v += stride) {
+    for (std::size_t v = 0, i = 0; v < target.vertexCount(); v += stride, ++i) {
       const Vec3 point = target.vertex(v);
-      const core::ClosestPointTree::Hit hit = currentTree.closest(point);
+      if (onBoundary[i] == MorphTarget::kNoHint && i > 0) onBoundary[i] = onBoundary[i - 1];
+      const core::ClosestPointTree::Hit hit = currentTree.closest(point, onBoundary[i]);
+      onBoundary[i] = hit.triangle;
       const auto& t = current.triangles[hit.triangle];
       addPoint(t, hit.closest.barycentric, point, w * vertexArea[v] * static_cast<double>(stride));
     }
@@ -219,7 +229,14 @@ Result<MorphTarget> MorphTarget::prepare(core::TriangleMesh surface) {
 }
 
 Vec3 MorphTarget::View::closestPoint(const Vec3& p) const {
-  return mFrame * mTarget->tree().closest(mFrame.transpose() * p).closest.point;
+  std::uint32_t none = kNoHint;
+  return closestPoint(p, none);
+}
+
+Vec3 MorphTarget::View::closestPoint(const Vec3& p, std::uint32_t& near) const {
+  const core::ClosestPointTree::Hit hit = mTarget->tree().closest(mFrame.transpose() * p, near);
+  near = hit.triangle;
+  return mFrame * hit.closest.point;
 }
 
 core::Mat3 MorphTarget::View::covariance() const {
@@ -267,10 +284,14 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
   for (std::uint32_t node : boundary.nodes)
     isBoundary[node] = 1;
   detail::InteriorMotion motion(out.mesh, isBoundary);
-  registerElastically(out.mesh, boundary, target, options.registrationRounds, minQuality, motion.stiffness());
+  std::vector<std::uint32_t> nearest(boundary.nodes.size(), MorphTarget::kNoHint);
+  registerElastically(out.mesh, boundary, target, options.registrationRounds, minQuality, motion.stiffness(),
+                      nearest);
   std::vector<Vec3> p(boundary.nodes.size());
-  for (std::size_t i = 0; i < p.size(); ++i)
-    p[i] = target.closestPoint(out.mesh.nodes[boundary.nodes[i]]);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (nearest[i] == MorphTarget::kNoHint && i > 0) nearest[i] = nearest[i - 1];
+    p[i] = target.closestPoint(out.mesh.nodes[boundary.nodes[i]], nearest[i]);
+  }
   Eigen::VectorXd move(3 * static_cast<Eigen::Index>(p.size()));
   for (std::size_t i = 0; i < p.size(); ++i)
     move.segment<3>(3 * static_cast<Eigen::Index>(i)) = p[i] - out.mesh.nodes[boundary.nodes[i]];
@@ -358,8 +379,12 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
   const std::size_t stride = std::max<std::size_t>(1, target.vertexCount() / 2000);
   double distance = 0.0;
   std::size_t count = 0;
-  for (std::size_t v = 0; v < target.vertexCount(); v += stride, ++count)
-    distance += std::sqrt(morphed.closest(target.vertex(v)).closest.squaredDistance);
+  std::uint32_t near = MorphTarget::kNoHint;  // the previous point's face: the target's vertices come in runs
+  for (std::size_t v = 0; v < target.vertexCount(); v += stride, ++count) {
+    const core::ClosestPointTree::Hit hit = morphed.closest(target.vertex(v), near);
+    near = hit.triangle;
+    distance += std::sqrt(hit.closest.squaredDistance);
+  }
   out.report.meanTargetDistance = distance / static_cast<double>(count);
   return out;
 }

@@ -123,6 +123,10 @@ class SurfaceSide {
   explicit SurfaceSide(const TriangleMesh& closedSurface);
   /// The distance from p to the surface, negative inside.
   double signedDistance(const Vec3& p) const;
+  /// The same, the search started from triangle `near` (the one found for a nearby point, say; a value
+  /// out of range for none), which is then set to the triangle found: the same distance whatever the
+  /// start (ClosestPointTree::closest).
+  double signedDistance(const Vec3& p, std::uint32_t& near) const;
   bool inside(const Vec3& p) const { return signedDistance(p) < 0.0; }
   /// The closest-point tree it searches, for other queries on the same surface.
   const ClosestPointTree& tree() const { return mTree; }

@@ -4,6 +4,8 @@
 // onto the query's own surface they have the query's, and modes computed on them are the query's to
 // within what the entry's resolution can hold.
 
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -91,8 +93,16 @@ class MorphTarget {
     std::size_t vertexCount() const { return mTarget->mSurface.vertices.size(); }
     core::Vec3 vertex(std::size_t v) const { return mFrame * mTarget->mSurface.vertices[v]; }
     core::Vec3 closestPoint(const core::Vec3& p) const;
+    /// The same, the search started from the target's triangle `near` (the one found for a nearby point,
+    /// or for this point before it moved; kNoHint for none), which is then set to the triangle found: the
+    /// same point whatever the start, found sooner from a good one.
+    core::Vec3 closestPoint(const core::Vec3& p, std::uint32_t& near) const;
     /// Whether p lies inside the surface. Precondition: massProperties() (the surface bounds a solid).
     bool inside(const core::Vec3& p) const { return mTarget->mSide.inside(mFrame.transpose() * p); }
+    /// The same, started from and setting `near` as closestPoint does.
+    bool inside(const core::Vec3& p, std::uint32_t& near) const {
+      return mTarget->mSide.signedDistance(mFrame.transpose() * p, near) < 0.0;
+    }
     /// ∫ (x − c)(x − c)ᵀ dV about the centre of mass, in the mesh's frame. Precondition: massProperties().
     core::Mat3 covariance() const;
 
@@ -100,6 +110,8 @@ class MorphTarget {
     const MorphTarget* mTarget;
     core::Mat3 mFrame;
   };
+  /// No triangle to start a search from (View::closestPoint, View::inside).
+  static constexpr std::uint32_t kNoHint = std::numeric_limits<std::uint32_t>::max();
   /// In the target's own frame.
   View view() const { return View(*this, core::Mat3::Identity()); }
 
