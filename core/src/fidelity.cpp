@@ -126,18 +126,7 @@ Bounds compoundBounds(const CollisionCompound& compound) {
   Bounds box{Vec3::Constant(std::numeric_limits<double>::infinity()),
              Vec3::Constant(-std::numeric_limits<double>::infinity())};
   for (const CollisionShape& shape : compound.shapes) {
-    Vec3 half = Vec3::Zero();
-    switch (shape.type) {
-      case CollisionShape::Type::kSphere:
-        half = Vec3::Constant(shape.radius);
-        break;
-      case CollisionShape::Type::kBox:
-        half = shape.rotation.cwiseAbs() * shape.halfExtents;
-        break;
-      case CollisionShape::Type::kCapsule:
-        half = shape.rotation.col(2).cwiseAbs() * shape.halfLength + Vec3::Constant(shape.radius);
-        break;
-    }
+    const Vec3 half = shape.halfSpan();
     box.min = box.min.cwiseMin(shape.center - half);
     box.max = box.max.cwiseMax(shape.center + half);
   }

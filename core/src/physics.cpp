@@ -233,6 +233,18 @@ double CollisionShape::volume() const {
   return 0.0;
 }
 
+Vec3 CollisionShape::halfSpan() const {
+  switch (type) {
+    case Type::kSphere:
+      return Vec3::Constant(radius);
+    case Type::kBox:
+      return rotation.cwiseAbs() * halfExtents;
+    case Type::kCapsule:
+      return rotation.col(2).cwiseAbs() * halfLength + Vec3::Constant(radius);
+  }
+  return Vec3::Zero();
+}
+
 const char* toString(CollisionShape::Type type) {
   switch (type) {
     case CollisionShape::Type::kSphere:

@@ -54,7 +54,10 @@ TEST(VolumeOverlap, CompoundBoundsHoldEveryShapeTightly) {
   capsule.rotation = Eigen::AngleAxisd(0.4, Vec3::UnitY()).toRotationMatrix();
   capsule.radius = 0.2;
   capsule.halfLength = 0.6;
-  compound.shapes = {box, capsule};
+  CollisionShape sphere;
+  sphere.center = Vec3(0.3, -1.5, 1.0);
+  sphere.radius = 0.3;
+  compound.shapes = {box, capsule, sphere};
   const Bounds b = compoundBounds(compound);
   // Every point inside lies within the bounds, and the bounds are reached within a sampling step.
   Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);

@@ -116,18 +116,7 @@ class Fitter {
   template <typename F>
   void forEachVoxelIn(const CollisionShape& shape, F&& f) const {
     // The shape's bounding box in voxel indices, then the exact test per voxel centre.
-    Vec3 half;
-    switch (shape.type) {
-      case CollisionShape::Type::kSphere:
-        half = Vec3::Constant(shape.radius);
-        break;
-      case CollisionShape::Type::kBox:
-        half = shape.rotation.cwiseAbs() * shape.halfExtents;
-        break;
-      case CollisionShape::Type::kCapsule:
-        half = shape.rotation.col(2).cwiseAbs() * shape.halfLength + Vec3::Constant(shape.radius);
-        break;
-    }
+    const Vec3 half = shape.halfSpan();
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::max(0, static_cast<int>(std::floor((shape.center[a] - half[a] - s.origin[a]) / s.voxel)));

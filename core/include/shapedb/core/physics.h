@@ -104,6 +104,8 @@ struct CollisionShape {
   /// True when `p` (canonical frame) lies inside the solid.
   bool contains(const Vec3& p) const;
   double volume() const;
+  /// Half the extent of its axis-aligned bounding box along x, y and z (canonical frame), about `center`.
+  Vec3 halfSpan() const;
 };
 
 /// "sphere", "box", "capsule".
