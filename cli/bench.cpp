@@ -148,15 +148,10 @@ Command addBenchCommand(CLI::App& parent) {
   CLI::Option* queries = app->add_option(
       "--queries", o->queries,
       "Directory of closed meshes (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae) to evaluate");
-  CLI::Option* fractureOption = app->add_option(
-      "--fracture", o->fractureMesh,
-      "Instead of --queries: break this closed mesh into fragments (as shapedb fracture) and evaluate them");
-  fractureOption->excludes(queries);
-  app->add_option("--pieces", o->fracture.pieces, "With --fracture: Voronoi seeds")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000))
-      ->needs(fractureOption);
-  addFractureFlags(*app, o->fracture);
+  addFractureSourceFlags(
+      *app, o->fractureMesh, o->fracture,
+      "Instead of --queries: break this closed mesh into fragments (as shapedb fracture) and evaluate them")
+      ->excludes(queries);
   addMeshLoadFlags(*app, o->load);
   app->add_option("--out", o->out, "Directory for the results (created)")->required();
   addMaterialFlags(*app, o->material);

@@ -56,8 +56,12 @@ struct MeshLoadFlags {
 /// Loads a mesh file and fractures it; errors name the file. Shared by fracture and haptic --fracture.
 Result<volume::FractureResult> fractureMeshFile(const std::string& path, const MeshLoadFlags& load,
                                                 const volume::FractureOptions& options);
-/// Adds --seed and --resolution for `options`.
+/// Adds --seed, --resolution and --max-triangles for `options`.
 void addFractureFlags(CLI::App& app, volume::FractureOptions& options);
+/// For a command that can take a mesh's fragments in place of its meshes: --fracture MESH (`description`
+/// says what the fragments stand for), --pieces, which needs it, and addFractureFlags. Returns --fracture.
+CLI::Option* addFractureSourceFlags(CLI::App& app, std::string& mesh, volume::FractureOptions& options,
+                                    const std::string& description);
 
 /// Prints "shapedb: <message>" on stderr, one line.
 void printError(const std::string& message);

@@ -184,11 +184,8 @@ Command addDropCommand(CLI::App& parent) {
   app->add_option("DB", o->database, "Database file (shapedb build)")->required();
   app->add_option("MESH", o->meshes,
                   "Closed meshes to drop (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)");
-  app->add_option("--fracture", o->fractureMesh, "Drop the fragments of this closed mesh instead");
-  app->add_option("--pieces", o->fracture.pieces, "With --fracture: Voronoi seeds")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
-  addFractureFlags(*app, o->fracture);
+  addFractureSourceFlags(*app, o->fractureMesh, o->fracture,
+                         "Drop the fragments of this closed mesh instead");
   addMeshLoadFlags(*app, o->load);
   addMaterialFlags(*app, o->material);
   app->add_option("--height", o->height, "Height of the lowest point at the start (m)")

@@ -94,6 +94,17 @@ void addFractureFlags(CLI::App& app, volume::FractureOptions& options) {
       ->check(CLI::Range(std::size_t{100}, std::size_t{1'000'000}));
 }
 
+CLI::Option* addFractureSourceFlags(CLI::App& app, std::string& mesh, volume::FractureOptions& options,
+                                    const std::string& description) {
+  CLI::Option* fracture = app.add_option("--fracture", mesh, description);
+  app.add_option("--pieces", options.pieces, "With --fracture: Voronoi seeds")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000))
+      ->needs(fracture);
+  addFractureFlags(app, options);
+  return fracture;
+}
+
 Command addFractureCommand(CLI::App& parent) {
   auto o = std::make_shared<FractureCommandOptions>();
   CLI::App* app = parent.add_subcommand(

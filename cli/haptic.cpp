@@ -242,15 +242,10 @@ Command addHapticCommand(CLI::App& parent) {
       "Directory of surface meshes (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae), each an object in "
       "world coordinates, "
       "metres");
-  CLI::Option* fractureOption = app->add_option(
-      "--fracture", o->fractureMesh,
-      "Instead of SCENE_DIR: break this closed mesh into fragments (as shapedb fracture) and use "
-      "them, in place, as the scene");
-  app->add_option("--pieces", o->fracture.pieces, "With --fracture: Voronoi seeds")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000))
-      ->needs(fractureOption);
-  addFractureFlags(*app, o->fracture);
+  addFractureSourceFlags(
+      *app, o->fractureMesh, o->fracture,
+      "Instead of SCENE_DIR: break this closed mesh into fragments (as shapedb fracture) and "
+      "use them, in place, as the scene");
   addMeshLoadFlags(*app, o->load);
   app->add_option("--report", o->report, "JSON report file")->required();
   app->add_option("--rate", o->loop.rateHz, "Loop rate, Hz")

@@ -54,5 +54,16 @@ TEST(DropCli, PlateFragmentsFallComeToRestOnTheFloorAndFramesAreWritten) {
   EXPECT_EQ(test::runProcess(SHAPEDB_CLI, {"drop", db.string()}).exitCode, 2);
 }
 
+TEST(DropCli, PiecesWithoutAFractureIsAnError) {
+  // --pieces counts the fragments of --fracture's mesh: given alone, it would be ignored.
+  test::ScratchDir dir("drop-cli-pieces");
+  const auto mesh = dir / "cube.obj";
+  ASSERT_TRUE(io::saveMesh(core::makeBox({0.1, 0.1, 0.1}), mesh).ok());
+  const test::ProcessResult drop = test::runProcess(
+      SHAPEDB_CLI, {"drop", (dir / "no.db").string(), mesh.string(), "--pieces", "4", "--json"});
+  EXPECT_EQ(drop.exitCode, 2);
+  EXPECT_NE(drop.err.find("--fracture"), std::string::npos) << drop.err;
+}
+
 }  // namespace
 }  // namespace shapedb::cli
