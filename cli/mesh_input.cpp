@@ -43,14 +43,15 @@ void addMeshLoadFlags(CLI::App& app, MeshLoadFlags& flags) {
          "Multiply the mesh files' coordinates by this to get metres")
       ->check(CLI::PositiveNumber)
       ->excludes(units);
-  app.add_flag(
+  CLI::Option* repair = app.add_flag(
       "--repair", flags.repair,
       "Make a closed surface of an open, non-manifold or self-intersecting one: holes up to a tenth\n"
       "of the mesh across are shut, the rest stays within a voxel (a level set; prints what changed)");
   app.add_option("--repair-resolution", flags.repairOptions.resolution,
                  "With --repair: voxels along the mesh's largest side")
       ->capture_default_str()
-      ->check(CLI::Range(16, 1024));
+      ->check(CLI::Range(16, 1024))
+      ->needs(repair);
   app.add_flag_function(
       "--keep-specks", [&flags](std::int64_t) { flags.options.dropSpecks = false; },
       "Keep a mesh's detached parts under 0.001 of its largest part's area (a scan's floating specks),\n"

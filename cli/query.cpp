@@ -630,20 +630,22 @@ Command addQueryCommand(CLI::App& parent) {
          "nearest entry's own spectrum, as the paper has it")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
-  app->add_flag(
-         "--correct", o->correct,
-         "Geometry correction: morph the best entries' tets onto the mesh's own surface (see\n"
-         "--correct-candidates), and compute the modes again on the morph that reaches the surface\n"
-         "best, so that the data have the mesh's proportions and thin parts, not the entry's (tens to\n"
-         "hundreds of ms per query; where no morph keeps every tet positive, the best entry's own data\n"
-         "stand, with a warning). JSON gains \"correction\": the morph's quality and cost, and\n"
-         "\"answered\": the rank (from 0) of the match whose data the answer carries")
-      ->excludes(app->get_option("--stretch"));
+  CLI::Option* correct =
+      app->add_flag(
+             "--correct", o->correct,
+             "Geometry correction: morph the best entries' tets onto the mesh's own surface (see\n"
+             "--correct-candidates), and compute the modes again on the morph that reaches the surface\n"
+             "best, so that the data have the mesh's proportions and thin parts, not the entry's (tens to\n"
+             "hundreds of ms per query; where no morph keeps every tet positive, the best entry's own data\n"
+             "stand, with a warning). JSON gains \"correction\": the morph's quality and cost, and\n"
+             "\"answered\": the rank (from 0) of the match whose data the answer carries")
+          ->excludes(app->get_option("--stretch"));
   app->add_option("--correct-candidates", o->correctCandidates,
                   "With --correct: how many of the best matches are morphed to choose from (the search\n"
                   "finds at least as many; each costs one morph, a fraction of the modes' cost)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100));
+      ->check(CLI::Range(1, 100))
+      ->needs(correct);
   app->add_flag("--enrich", o->enrich,
                 "Learn each mesh too: compute its exact data in the background (the database's own\n"
                 "pipeline, seconds a mesh, on all cores), add them to DB as a 'learned' entry (DB must be\n"

@@ -7,6 +7,9 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -466,6 +469,19 @@ TEST(QueryCli, BadInputsAreClearErrors) {
       {"query", db.string(), good.string(), "--density", "1000", "--youngs", "1e9", "--poisson", "0.45"});
   EXPECT_EQ(custom.exitCode, 0) << custom.err;
   EXPECT_NE(custom.out.find("warning: material Poisson ratio"), std::string::npos) << custom.out;
+
+  // An option that only means something beside another is an error without it, not ignored.
+  for (const auto& [alone, needed] :
+       {std::pair{std::vector<std::string>{"--correct-candidates", "2"}, "--correct"},
+        std::pair{std::vector<std::string>{"--repair-resolution", "64"}, "--repair"},
+        std::pair{std::vector<std::string>{"--enrich-above", "0.1"}, "--enrich"}}) {
+    std::vector<std::string> args{"query", db.string(), good.string()};
+    args.insert(args.end(), alone.begin(), alone.end());
+    const test::ProcessResult result = test::runProcess(SHAPEDB_CLI, args);
+    EXPECT_EQ(result.exitCode, 2) << alone[0];
+    EXPECT_NE(result.err.find(std::string(alone[0]) + " requires " + needed), std::string::npos)
+        << result.err;
+  }
 
   test::ProcessResult notDb = test::runProcess(SHAPEDB_CLI, {"query", good.string(), good.string()});
   EXPECT_EQ(notDb.exitCode, 1);
