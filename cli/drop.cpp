@@ -203,10 +203,12 @@ Command addDropCommand(CLI::App& parent) {
   app->add_option("--restitution", o->restitution, "Restitution of every contact")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  app->add_option("--frames", o->frames, "Write frame-0000.png, ... (a view from the front) into DIR");
-  app->add_option("--frame-rate", o->frameRate, "Frames per simulated second, with --frames")
+  CLI::Option* frames =
+      app->add_option("--frames", o->frames, "Write frame-0000.png, ... (a view from the front) into DIR");
+  app->add_option("--frame-rate", o->frameRate, "With --frames: frames per simulated second")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 1000.0));
+      ->check(CLI::Range(1.0, 1000.0))
+      ->needs(frames);
   app->add_flag(
       "--json", o->json,
       "Print one JSON object: {bodies: [{name, mass, shapes, start_center_of_mass, "

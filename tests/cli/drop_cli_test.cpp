@@ -1,6 +1,9 @@
 // shapedb drop as a user runs it: a plate fractured, its fragments given mass properties and compounds
 // by a real database, dropped in Bullet; the JSON read back.
 
+#include <string>
+#include <utility>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -54,15 +57,19 @@ TEST(DropCli, PlateFragmentsFallComeToRestOnTheFloorAndFramesAreWritten) {
   EXPECT_EQ(test::runProcess(SHAPEDB_CLI, {"drop", db.string()}).exitCode, 2);
 }
 
-TEST(DropCli, PiecesWithoutAFractureIsAnError) {
-  // --pieces counts the fragments of --fracture's mesh: given alone, it would be ignored.
-  test::ScratchDir dir("drop-cli-pieces");
+TEST(DropCli, AnOptionWithoutTheOneItQualifiesIsAnError) {
+  // --pieces counts the fragments of --fracture's mesh, --frame-rate the frames of --frames: given alone,
+  // either would be ignored.
+  test::ScratchDir dir("drop-cli-alone");
   const auto mesh = dir / "cube.obj";
   ASSERT_TRUE(io::saveMesh(core::makeBox({0.1, 0.1, 0.1}), mesh).ok());
-  const test::ProcessResult drop = test::runProcess(
-      SHAPEDB_CLI, {"drop", (dir / "no.db").string(), mesh.string(), "--pieces", "4", "--json"});
-  EXPECT_EQ(drop.exitCode, 2);
-  EXPECT_NE(drop.err.find("--fracture"), std::string::npos) << drop.err;
+  for (const auto& [alone, needed] :
+       {std::pair{"--pieces", "--fracture"}, std::pair{"--frame-rate", "--frames"}}) {
+    const test::ProcessResult drop = test::runProcess(
+        SHAPEDB_CLI, {"drop", (dir / "no.db").string(), mesh.string(), alone, "4", "--json"});
+    EXPECT_EQ(drop.exitCode, 2) << alone;
+    EXPECT_NE(drop.err.find(std::string(alone) + " requires " + needed), std::string::npos) << drop.err;
+  }
 }
 
 }  // namespace
