@@ -111,7 +111,10 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
       " entries, " + volume::toString(db->parameters().entry.modal.order) + " tets), " + material->name +
       "; truth and baselines on " + volume::toString(o.evaluation.directElements) +
       " tets, the truth's with a TetGen volume bound " + refinement +
-      std::string("x smaller than the entries'");
+      std::string("x smaller than the entries'") +
+      (o.evaluation.correctionCandidates == io::QueryOptions{}.correctionCandidates
+           ? std::string()
+           : "; the correction morphs " + std::to_string(o.evaluation.correctionCandidates) + " candidates");
   for (Status st : {bench::writeEvaluationCsv(*evaluations, out / "evaluation.csv"),
                     bench::writeEvaluationSummary(*evaluations, title, out / "summary.md"),
                     bench::writeEvaluationPlots(*evaluations, out)})
@@ -175,6 +178,11 @@ Command addBenchCommand(CLI::App& parent) {
                   "quadratic solve on the tets of a 100k-triangle scan does not fit in memory)")
       ->capture_default_str()
       ->check(CLI::Range(100, 1000000));
+  app->add_option("--correct-candidates", o->evaluation.correctionCandidates,
+                  "The corrected method's candidates: how many of the best matches are morphed to choose\n"
+                  "from (as query --correct-candidates)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
   app->add_option("--threads", o->evaluation.threads, "Threads for the direct computations (0: all cores)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

@@ -590,7 +590,8 @@ PYBIND11_MODULE(_shapedb, m) {
           },
           "vertices"_a, "faces"_a, py::kw_only(), "k"_a = 1, "descriptor"_a = "centroid-voxel",
           "material"_a = "steel", "correct"_a = false, "fidelity"_a = true, "approximate"_a = false,
-          "adapt"_a = true, "correction_candidates"_a = 3, "neighbours"_a = io::QueryOptions{}.neighbours)
+          "adapt"_a = true, "correction_candidates"_a = io::QueryOptions{}.correctionCandidates,
+          "neighbours"_a = io::QueryOptions{}.neighbours)
       .def(
           "query_many",
           [](const PyDatabase& db, const py::iterable& meshes, int k, const std::string& descriptor,
@@ -601,7 +602,8 @@ PYBIND11_MODULE(_shapedb, m) {
           },
           "meshes"_a, py::kw_only(), "k"_a = 1, "descriptor"_a = "centroid-voxel", "material"_a = "steel",
           "correct"_a = false, "fidelity"_a = true, "approximate"_a = false, "adapt"_a = true,
-          "correction_candidates"_a = 3, "neighbours"_a = io::QueryOptions{}.neighbours)
+          "correction_candidates"_a = io::QueryOptions{}.correctionCandidates,
+          "neighbours"_a = io::QueryOptions{}.neighbours)
       .def("info", &PyDatabase::info)
       .def("close", &PyDatabase::close)
       .def("__len__", &PyDatabase::size)

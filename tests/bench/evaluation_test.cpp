@@ -152,6 +152,9 @@ TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
   // Bad options are errors before any work.
   options.frequencies = 7;  // the database has 6 modes
   EXPECT_EQ(evaluateShapes(*db, shapes, options).error().code, ErrorCode::kInvalidArgument);
+  options.frequencies = 5;
+  options.correctionCandidates = 0;
+  EXPECT_EQ(evaluateShapes(*db, shapes, options).error().code, ErrorCode::kInvalidArgument);
 }
 
 TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {

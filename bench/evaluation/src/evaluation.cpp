@@ -189,6 +189,9 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
   if (options.overlapResolution < 8 || options.overlapResolution > 512)
     return Error{ErrorCode::kInvalidArgument, "the overlap resolution must be 8 to 512 cells, not " +
                                                   std::to_string(options.overlapResolution)};
+  if (options.correctionCandidates < 1 || options.correctionCandidates > 100)
+    return Error{ErrorCode::kInvalidArgument, "the correction's candidates must be 1 to 100, not " +
+                                                  std::to_string(options.correctionCandidates)};
   if (Status st = core::validateMaterial(options.material); !st) return st.error();
 
   std::vector<FragmentEvaluation> out(shapes.size());
@@ -209,6 +212,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
       q.search.k = 1;
       if (kQueries[k].momentWeight) q.search.momentWeight = *kQueries[k].momentWeight;
       q.correct = kQueries[k].correct;
+      q.correctionCandidates = options.correctionCandidates;
       if (kQueries[k].neighbours) q.neighbours = *kQueries[k].neighbours;
       q.material = options.material;
       q.fidelity = true;  // its evidence is recorded; its time is not counted

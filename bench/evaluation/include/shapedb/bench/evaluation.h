@@ -122,6 +122,8 @@ struct EvaluationOptions {
   /// size L) before its truth is computed: the tets of a 100k-triangle scan would not fit the memory of a
   /// quadratic solve. Its queries see the shape as it is.
   std::size_t truthMaxTriangles = 8000;
+  /// The corrected method's io::QueryOptions::correctionCandidates.
+  int correctionCandidates = io::QueryOptions{}.correctionCandidates;
   /// Called after each shape's direct computation, from one thread at a time: done, total, its name.
   std::function<void(std::size_t, std::size_t, const std::string&)> progress;
 };
