@@ -587,7 +587,7 @@ Vec3 SurfaceSide::faceNormal(std::uint32_t triangle) const {
 }
 
 double SurfaceSide::signedDistance(const Vec3& p) const {
-  std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t none = ClosestPointTree::kNoHint;
   return signedDistance(p, none);
 }
 

@@ -211,7 +211,7 @@ void expectSidesAgreeWithWindingNumber(const TriangleMesh& surface, std::mt19937
   int insides = 0;
   // Every other search started from the triangle found for the point before, an unrelated one: the start
   // must not change the answer.
-  std::uint32_t hint = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t hint = ClosestPointTree::kNoHint;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const double winding = windingNumber(surface, points[i]);
     ASSERT_LT(std::min(std::abs(winding), std::abs(winding - 1.0)), 1e-6) << "point " << i;

@@ -54,11 +54,13 @@ class ClosestPointTree {
   };
   /// The closest point of the surface to `p`. Precondition: the surface has a triangle.
   Hit closest(const Vec3& p) const;
-  /// The same, starting from triangle `hint` (say, the answer for a nearby point): its distance bounds
-  /// the search from the start, so fewer boxes are opened. The same closest point and distance whatever
-  /// the hint; where several triangles are equally close (at a shared edge or vertex) it may name
-  /// another of them.
+  /// The same, starting from triangle `hint` (say, the answer for a nearby point; kNoHint, or any value
+  /// out of range, for none): its distance bounds the search from the start, so fewer boxes are opened.
+  /// The same closest point and distance whatever the hint; where several triangles are equally close
+  /// (at a shared edge or vertex) it may name another of them.
   Hit closest(const Vec3& p, std::uint32_t hint) const;
+  /// No triangle to start a search from (closest, and the searches built on it).
+  static constexpr std::uint32_t kNoHint = std::numeric_limits<std::uint32_t>::max();
   /// The first triangle other than `skip` that the ray origin + t·direction crosses at a t over
   /// `minDistance`, nearest box first; none if it crosses none. Where it crosses several at the same t
   /// (through a shared edge) it may name any of them.
@@ -123,9 +125,9 @@ class SurfaceSide {
   explicit SurfaceSide(const TriangleMesh& closedSurface);
   /// The distance from p to the surface, negative inside.
   double signedDistance(const Vec3& p) const;
-  /// The same, the search started from triangle `near` (the one found for a nearby point, say; a value
-  /// out of range for none), which is then set to the triangle found: the same distance whatever the
-  /// start (ClosestPointTree::closest).
+  /// The same, the search started from triangle `near` (the one found for a nearby point, say;
+  /// ClosestPointTree::kNoHint for none), which is then set to the triangle found: the same distance
+  /// whatever the start (ClosestPointTree::closest).
   double signedDistance(const Vec3& p, std::uint32_t& near) const;
   bool inside(const Vec3& p) const { return signedDistance(p) < 0.0; }
   /// The closest-point tree it searches, for other queries on the same surface.

@@ -5,7 +5,6 @@
 // within what the entry's resolution can hold.
 
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <vector>
 
@@ -110,8 +109,8 @@ class MorphTarget {
     const MorphTarget* mTarget;
     core::Mat3 mFrame;
   };
-  /// No triangle to start a search from (View::closestPoint, View::inside).
-  static constexpr std::uint32_t kNoHint = std::numeric_limits<std::uint32_t>::max();
+  /// No triangle to start a search from (View::closestPoint, View::inside): the target's tree's.
+  static constexpr std::uint32_t kNoHint = core::ClosestPointTree::kNoHint;
   /// In the target's own frame.
   View view() const { return View(*this, core::Mat3::Identity()); }
 
