@@ -182,7 +182,7 @@ Command addBenchCommand(CLI::App& parent) {
                   "The corrected method's candidates: how many of the best matches are morphed to choose\n"
                   "from (as query --correct-candidates)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100));
+      ->check(CLI::Range(1, io::kMaxCorrectionCandidates));
   app->add_option("--threads", o->evaluation.threads, "Threads for the direct computations (0: all cores)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

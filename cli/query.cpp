@@ -644,7 +644,7 @@ Command addQueryCommand(CLI::App& parent) {
                   "With --correct: how many of the best matches are morphed to choose from (the search\n"
                   "finds at least as many; each costs one morph, a fraction of the modes' cost)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100))
+      ->check(CLI::Range(1, io::kMaxCorrectionCandidates))
       ->needs(correct);
   app->add_flag("--enrich", o->enrich,
                 "Learn each mesh too: compute its exact data in the background (the database's own\n"

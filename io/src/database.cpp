@@ -451,8 +451,11 @@ Result<QueryResult> Database::query(const core::TriangleMesh& mesh, const QueryO
                  "the neighbours whose spectra are blended must be 1 to 100, not " +
                      std::to_string(options.neighbours)};
   const bool correcting = options.adapt && options.correct;
-  if (correcting && (options.correctionCandidates < 1 || options.correctionCandidates > 100))
-    return Error{ErrorCode::kInvalidArgument, "the geometry correction's candidates must be 1 to 100"};
+  if (correcting &&
+      (options.correctionCandidates < 1 || options.correctionCandidates > kMaxCorrectionCandidates))
+    return Error{ErrorCode::kInvalidArgument, "the geometry correction's candidates must be 1 to " +
+                                                  std::to_string(kMaxCorrectionCandidates) + ", not " +
+                                                  std::to_string(options.correctionCandidates)};
   if (!hasIndex(options.descriptor))
     return Error{ErrorCode::kInvalidArgument, mImpl->store.path().string() + ": opened without its " +
                                                   core::toString(options.descriptor) +

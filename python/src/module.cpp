@@ -337,7 +337,10 @@ class PyDatabase {
 io::QueryOptions queryOptions(int k, const std::string& descriptor, const py::object& material, bool correct,
                               bool fidelity, bool approximate, bool adapt, int candidates, int neighbours) {
   if (k < 1) throw py::value_error("k must be at least 1, not " + std::to_string(k));
-  if (candidates < 1) throw py::value_error("correction_candidates must be at least 1");
+  if (candidates < 1 || candidates > io::kMaxCorrectionCandidates)
+    throw py::value_error("correction_candidates must be 1 to " +
+                          std::to_string(io::kMaxCorrectionCandidates) + ", not " +
+                          std::to_string(candidates));
   if (neighbours < 1 || neighbours > 100)
     throw py::value_error("neighbours must be 1 to 100, not " + std::to_string(neighbours));
   io::QueryOptions o;

@@ -483,6 +483,13 @@ TEST(QueryCli, BadInputsAreClearErrors) {
         << result.err;
   }
 
+  // The candidates' bound is the library's (io::kMaxCorrectionCandidates).
+  const test::ProcessResult tooMany = test::runProcess(
+      SHAPEDB_CLI, {"query", db.string(), good.string(), "--correct", "--correct-candidates", "101"});
+  EXPECT_EQ(tooMany.exitCode, 2);
+  EXPECT_NE(tooMany.err.find("--correct-candidates"), std::string::npos) << tooMany.err;
+  EXPECT_NE(tooMany.err.find("100"), std::string::npos) << tooMany.err;
+
   test::ProcessResult notDb = test::runProcess(SHAPEDB_CLI, {"query", good.string(), good.string()});
   EXPECT_EQ(notDb.exitCode, 1);
   EXPECT_NE(notDb.err.find("good.obj"), std::string::npos) << notDb.err;

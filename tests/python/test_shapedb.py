@@ -118,6 +118,9 @@ def test_a_query_is_the_tools_bit_for_bit(cli, samples, database, name):
     assert nearest.physics["spectrum_weights"] == [1.0]
     with pytest.raises(ValueError, match="neighbours"):
         db.query(vertices, faces, neighbours=0)
+    for candidates in (0, 101):
+        with pytest.raises(ValueError, match="correction_candidates must be 1 to 100"):
+            db.query(vertices, faces, correct=True, correction_candidates=candidates)
 
 
 def test_query_results_hold_the_answers_data(samples, database):

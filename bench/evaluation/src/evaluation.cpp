@@ -189,8 +189,9 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
   if (options.overlapResolution < 8 || options.overlapResolution > 512)
     return Error{ErrorCode::kInvalidArgument, "the overlap resolution must be 8 to 512 cells, not " +
                                                   std::to_string(options.overlapResolution)};
-  if (options.correctionCandidates < 1 || options.correctionCandidates > 100)
-    return Error{ErrorCode::kInvalidArgument, "the correction's candidates must be 1 to 100, not " +
+  if (options.correctionCandidates < 1 || options.correctionCandidates > io::kMaxCorrectionCandidates)
+    return Error{ErrorCode::kInvalidArgument, "the correction's candidates must be 1 to " +
+                                                  std::to_string(io::kMaxCorrectionCandidates) + ", not " +
                                                   std::to_string(options.correctionCandidates)};
   if (Status st = core::validateMaterial(options.material); !st) return st.error();
 

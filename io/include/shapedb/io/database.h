@@ -25,6 +25,10 @@
 
 namespace shapedb::io {
 
+/// The most candidates a geometry correction morphs (QueryOptions::correctionCandidates): each is a morph
+/// on the query's critical path, and a search for more than this many is not a query any more.
+inline constexpr int kMaxCorrectionCandidates = 100;
+
 /// What Database::query does beyond matching.
 struct QueryOptions {
   core::DescriptorKind descriptor = core::DescriptorKind::kCentroidVoxel;
@@ -74,7 +78,7 @@ struct QueryOptions {
   /// one morph, a fraction of the modes' cost. On the benchmark, three took the median first-frequency
   /// error on real meshes from 24 % to 17 % and on fracture fragments from 5.9 % to 5.3 % and 3.7 % to
   /// 3.3 % (docs/architecture.md, "Which entry is morphed"). 1: the best match only.
-  int correctionCandidates = 3;
+  int correctionCandidates = 3;  ///< 1 to kMaxCorrectionCandidates
   /// With correct: where the best of the candidates' morphs leaves much of the query unfilled (its mass
   /// scale over volume::kMassScaleWarning: a part of the object that entry has no tets for, such as a
   /// thin plate's expanse around a ring's rim), more entries are morphed: the three nearest by shape
