@@ -99,6 +99,44 @@ TEST(Fracture, AMeshFarFromTheOriginBreaksAsAtTheOrigin) {
   }
 }
 
+TEST(Fracture, AMeshOfAnySizeBreaksAsAtItsOwn) {
+  // A part read in the wrong unit is microns across (or kilometres): OpenVDB refuses voxels that small
+  // ("Non-zero scale values required"), so fracture works in a frame of the mesh's own size. Up to the
+  // scale, the fragments are the same.
+  const core::TriangleMesh pebble = core::transformed(core::makeIcosphere(0.05, 3), [] {
+    core::Mat4 m = core::Mat4::Identity();
+    m.diagonal().head<3>() = Vec3(1.6, 1.0, 0.7);
+    return m;
+  }());
+  FractureOptions options;
+  options.pieces = 12;
+  options.seed = 5;
+  options.resolution = 64;
+  const Result<FractureResult> here = fracture(pebble, options);
+  ASSERT_TRUE(here.ok()) << here.error().message;
+  for (const double scale : {1e-7, 1e-4, 1e4}) {
+    SCOPED_TRACE(scale);
+    const core::TriangleMesh sized = core::transformed(pebble, [scale] {
+      core::Mat4 m = core::Mat4::Identity();
+      m.diagonal().head<3>() = Vec3::Constant(scale);
+      return m;
+    }());
+    const Result<FractureResult> there = fracture(sized, options);
+    ASSERT_TRUE(there.ok()) << there.error().message;
+    EXPECT_EQ(there->openDropped, 0u);
+    EXPECT_NEAR(there->voxelSize / here->voxelSize, scale, 1e-9 * scale);
+    EXPECT_NEAR(there->keptFraction(), here->keptFraction(), 1e-6);
+    EXPECT_NEAR(there->keptVolume / here->keptVolume, scale * scale * scale, 1e-5 * scale * scale * scale);
+    ASSERT_EQ(there->fragments.size(), here->fragments.size());
+    for (std::size_t i = 0; i < here->fragments.size(); ++i) {
+      const core::MassProperties a = *core::computeMassProperties(here->fragments[i]);
+      const core::MassProperties b = *core::computeMassProperties(there->fragments[i]);
+      EXPECT_NEAR(b.volume / (a.volume * scale * scale * scale), 1.0, 1e-5) << i;
+      EXPECT_LT((b.centerOfMass / scale - a.centerOfMass).norm(), 1e-3 * here->voxelSize) << i;
+    }
+  }
+}
+
 TEST(Fracture, TheAutomaticResolutionResolvesThinSolidsAndSmallPieces) {
   const core::TriangleMesh pebble = core::makeIcosphere(0.05, 3);
   EXPECT_EQ(automaticResolution(pebble, 20), 128);  // 128 voxels already put 16 across each piece

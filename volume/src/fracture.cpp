@@ -101,21 +101,26 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   // resolve a voxel's hundredth and the level sets' surfaces tear. The frame puts the mesh's bounds a few
   // voxels into the positive octant, so that the solid also lies within one of the grid tree's top-level
   // nodes (a solid straddling the origin, where all of them meet, came out of the CSG with a hole along
-  // the coordinate planes).
+  // the coordinate planes). Its unit is the mesh's largest side, so that the voxels are never too small
+  // for OpenVDB (it refuses a transform's scale under about 1e-8: a part read in the wrong unit, microns
+  // across, threw "Non-zero scale values required"); lengths and volumes go back to the mesh's units with
+  // the fragments.
   initializeOpenVdb();
   const core::Bounds worldBounds = core::computeBounds(mesh);
+  const double side = (worldBounds.max - worldBounds.min).maxCoeff();
   FractureResult result;
   result.solidVolume = volume;
   result.resolution =
       options.resolution != 0 ? options.resolution : automaticResolution(mesh, options.pieces);
-  result.voxelSize = (worldBounds.max - worldBounds.min).maxCoeff() / result.resolution;
+  result.voxelSize = side / result.resolution;
+  const double voxel = 1.0 / result.resolution;  // in the local frame
   const Vec3 origin = worldBounds.min - Vec3::Constant(kFrameMargin * result.voxelSize);
   TriangleMesh local = mesh;
   for (Vec3& p : local.vertices)
-    p -= origin;
+    p = (p - origin) / side;
+  const double localVolume = volume / (side * side * side);
   const core::Bounds bounds = core::computeBounds(local);
-  const openvdb::math::Transform::Ptr transform =
-      openvdb::math::Transform::createLinearTransform(result.voxelSize);
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(voxel);
   openvdb::FloatGrid::Ptr solid = detail::levelSet(local, *transform);
 
   // Seeds: uniform in the bounding box, kept where the level set says the point is inside.
@@ -140,7 +145,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   // what tools::LevelSetFracture does cutter by cutter, without its cost: it re-segments every fragment
   // made so far at each cut, quadratic in the pieces (200 pieces took minutes), and it drops a fragment
   // whose cutter leaves no residual (a cell that holds the whole solid).
-  const Vec3 margin = Vec3::Constant((detail::kLevelSetHalfWidth + 2.0) * result.voxelSize);
+  const Vec3 margin = Vec3::Constant((detail::kLevelSetHalfWidth + 2.0) * voxel);
   std::vector<std::vector<openvdb::FloatGrid::Ptr>> cellGrids(seeds.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seeds.size(), 1), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -164,15 +169,15 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
 
   std::vector<std::pair<TriangleMesh, Meshing>> surfaces(grids.size());
   tbb::parallel_for(std::size_t{0}, grids.size(), [&](std::size_t i) {
-    surfaces[i] =
-        detail::closedSurface(*grids[i], result.voxelSize,
-                              {.maxTriangles = options.maxTriangles, .simplifyError = options.simplifyError});
+    surfaces[i] = detail::closedSurface(
+        *grids[i], voxel, {.maxTriangles = options.maxTriangles, .simplifyError = options.simplifyError});
   });
 
+  // Volumes in the local frame's unit until the end.
   std::vector<std::pair<double, TriangleMesh>> pieces;
   for (auto& [piece, meshing] : surfaces) {
     if (piece.triangles.empty()) continue;
-    dropCrumbShells(piece, options.minVolumeFraction * volume, result);
+    dropCrumbShells(piece, options.minVolumeFraction * localVolume, result);
     const double v = core::computeSignedVolume(piece);
     if (meshing == Meshing::kOpen) {
       // No crossing near the zero level closed: never seen, and not passed on as a solid.
@@ -180,7 +185,7 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
       result.droppedVolume += std::max(v, 0.0);
       continue;
     }
-    if (v < options.minVolumeFraction * volume) {
+    if (v < options.minVolumeFraction * localVolume) {
       ++result.crumbsDropped;
       result.droppedVolume += std::max(v, 0.0);
       continue;
@@ -188,9 +193,11 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
     if (meshing == Meshing::kRemeshed) ++result.remeshed;
     result.keptVolume += v;
     for (Vec3& p : piece.vertices)
-      p += origin;
+      p = origin + side * p;
     pieces.emplace_back(v, std::move(piece));
   }
+  result.keptVolume *= side * side * side;
+  result.droppedVolume *= side * side * side;
   // Largest first; ties (never in practice) by the first vertex, so the order is the mesh's own.
   std::sort(pieces.begin(), pieces.end(), [](const auto& a, const auto& b) {
     if (a.first != b.first) return a.first > b.first;
