@@ -45,19 +45,26 @@ Error fileError(const std::filesystem::path& path, ErrorCode code, const std::st
 }
 
 // Binary STL is a header, a triangle count and 50 bytes per triangle. OpenMesh trusts the count, so a
-// truncated file or a lying count is caught here first. ASCII STL starts with "solid".
+// truncated file or a lying count is caught here first. ASCII STL starts with "solid"; so do the headers
+// of many binary ones (SolidWorks writes "solid NAME" there), whose count and first triangle then hold bytes
+// no text has.
 Status checkStlFraming(const std::filesystem::path& path, std::uintmax_t fileSize) {
   std::ifstream in(path, std::ios::binary);
-  std::array<char, 84> header{};
+  std::array<char, 134> header{};  // the header, the count and the first triangle of a binary file
   in.read(header.data(), header.size());
   const auto got = static_cast<std::size_t>(in.gcount());
   std::string start(header.data(), std::min<std::size_t>(got, 80));
   start.erase(0, start.find_first_not_of(" \t\r\n"));
-  if (got == header.size()) {
+  const bool text =
+      std::all_of(header.begin(), header.begin() + static_cast<std::ptrdiff_t>(got), [](char c) {
+        const auto u = static_cast<unsigned char>(c);
+        return u >= 0x20 || u == '\t' || u == '\n' || u == '\r';
+      });
+  if (got >= 84) {
     std::uint32_t claimed = 0;
     std::memcpy(&claimed, header.data() + 80, sizeof claimed);  // little-endian on every target we build
     if (84 + 50 * std::uintmax_t{claimed} == fileSize) return Ok{};
-    if (start.rfind("solid", 0) == 0) return Ok{};
+    if (start.rfind("solid", 0) == 0 && text) return Ok{};
     return fileError(path, ErrorCode::kParse,
                      "truncated or corrupt binary STL (header says " + std::to_string(claimed) +
                          " triangles, file holds " + std::to_string((fileSize - 84) / 50) + ")");

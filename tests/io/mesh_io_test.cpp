@@ -142,6 +142,13 @@ TEST(MeshIo, EmptyGarbageAndTruncatedFilesOfEachFormatAreErrors) {
   EXPECT_EQ(truncated.code, ErrorCode::kParse);
   EXPECT_NE(truncated.message.find("truncated or corrupt binary STL"), std::string::npos)
       << truncated.message;
+  // The same with a header that starts as ASCII STL does, as SolidWorks writes it.
+  std::string solidHeader = stl.substr(0, stl.size() - 30);
+  solidHeader.replace(0, 11, "solid blob ");
+  test::writeFile(dir / "truncated_solid.stl", solidHeader);
+  const Error truncatedSolid = mustFail(dir / "truncated_solid.stl");
+  EXPECT_NE(truncatedSolid.message.find("truncated or corrupt binary STL"), std::string::npos)
+      << truncatedSolid.message;
   test::writeFile(dir / "liar.stl", binaryStl(blob, 1u << 31));
   EXPECT_EQ(mustFail(dir / "liar.stl").code, ErrorCode::kParse);
   test::writeFile(dir / "short.stl", stl.substr(0, 40));
