@@ -10,6 +10,7 @@
 
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/core/primitives.h>
+#include <shapedb/core/self_intersection.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/repair.h>
 
@@ -19,9 +20,11 @@ namespace {
 using core::TriangleMesh;
 using core::Vec3;
 
+/// What a repair promises: closed, consistently oriented, wound outward, and not passing through itself
+/// (a simplification that folded a thin wall through another was a repair that needed repairing).
 bool closedAndOriented(const TriangleMesh& mesh) {
   return core::validateMesh(mesh).ok() && core::requireClosedOriented(core::analyzeTopology(mesh)).ok() &&
-         core::computeSignedVolume(mesh) > 0.0;
+         core::computeSignedVolume(mesh) > 0.0 && core::findSelfIntersections(mesh).empty();
 }
 
 /// `mesh` without the triangles whose centroids lie within `radius` of any of `centres`.

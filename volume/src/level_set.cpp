@@ -15,6 +15,7 @@
 
 #include <shapedb/core/disjoint_sets.h>
 #include <shapedb/core/mass_properties.h>
+#include <shapedb/core/self_intersection.h>
 #include <shapedb/core/spatial.h>
 #include <shapedb/core/topology.h>
 #include <shapedb/volume/repair.h>
@@ -339,6 +340,16 @@ Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOpti
 
   auto [surface, meshing] = detail::closedSurface(
       *solid, h, detail::SurfaceOptions{.maxTriangles = options.maxTriangles, .simplifyError = 0.25});
+  // The simplification can fold two sheets of a thin wall through each other, which the crossing of a
+  // level set never does: then the crossing stands, unsimplified (a repaired surface that still passed
+  // through itself would need repairing again).
+  if (meshing != detail::Meshing::kOpen && !core::findSelfIntersections(surface).empty()) {
+    auto [raw, rawMeshing] = detail::closedSurface(*solid, h, detail::SurfaceOptions{.maxTriangles = 0});
+    if (rawMeshing != detail::Meshing::kOpen && !raw.triangles.empty()) {
+      surface = std::move(raw);
+      meshing = rawMeshing;
+    }
+  }
   if (surface.triangles.empty() || meshing == detail::Meshing::kOpen)
     return Error{ErrorCode::kParse,
                  "no closed surface came out of the repair: the mesh encloses nothing that its holes "

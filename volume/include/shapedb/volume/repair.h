@@ -20,7 +20,9 @@ struct RepairOptions {
   /// Holes wider than this fraction of the largest side are refused: closing them would round off
   /// every concave part of the surface as much.
   double maxHoleFraction = 0.1;
-  /// The repaired surface is simplified to at most this many triangles (within a quarter voxel).
+  /// The repaired surface is simplified to at most this many triangles (within a quarter voxel), unless the
+  /// simplification would make it pass through itself (two sheets of a thin wall folded together): then it
+  /// is the level set's crossing, unsimplified.
   std::size_t maxTriangles = 20000;
 };
 
@@ -38,7 +40,7 @@ struct RepairReport {
 };
 
 struct RepairedSurface {
-  core::TriangleMesh mesh;  ///< closed, manifold, wound outward
+  core::TriangleMesh mesh;  ///< closed, manifold, wound outward, not passing through itself
   RepairReport report;
 };
 
