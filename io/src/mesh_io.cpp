@@ -260,11 +260,13 @@ Result<std::vector<std::filesystem::path>> listMeshFiles(const std::filesystem::
 Result<LoadedMesh> loadMesh(const std::filesystem::path& path, const LoadOptions& options) {
   // Format by extension, then the file itself.
   const std::string format = detail::lowercaseExtension(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return fileError(path, ErrorCode::kIo, "is a directory, not a mesh file");
   if (!detail::isMeshFormat(format))
     return fileError(path, ErrorCode::kUnknownFormat,
                      "unknown mesh format '" + path.extension().string() +
                          "' (expected .obj, .ply, .off, .stl, .gltf, .glb, .fbx or .dae)");
-  std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return fileError(path, ErrorCode::kIo,
                      std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");

@@ -346,7 +346,9 @@ Result<Store> Store::create(const std::filesystem::path& path, const BuildParame
 Result<Store> Store::open(const std::filesystem::path& path, bool writable) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    return Error{ErrorCode::kIo, path.string() + ": no such database file"};
+    return Error{ErrorCode::kIo, path.string() + (std::filesystem::is_directory(path, ec)
+                                                      ? ": is a directory, not a database file"
+                                                      : ": no such database file")};
   auto impl = Impl::connect(path, writable ? SQLITE_OPEN_READWRITE : SQLITE_OPEN_READONLY);
   if (!impl) return impl.error();
   Impl& s = **impl;

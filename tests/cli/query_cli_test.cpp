@@ -493,6 +493,16 @@ TEST(QueryCli, BadInputsAreClearErrors) {
   test::ProcessResult notDb = test::runProcess(SHAPEDB_CLI, {"query", good.string(), good.string()});
   EXPECT_EQ(notDb.exitCode, 1);
   EXPECT_NE(notDb.err.find("good.obj"), std::string::npos) << notDb.err;
+
+  // A folder where a file belongs, as the mesh and as the database: said so, not "unknown format" or
+  // "no such file".
+  const std::string folder = good.parent_path().string();
+  for (const auto& args : {std::vector<std::string>{"query", db.string(), folder},
+                           std::vector<std::string>{"query", folder, good.string()}}) {
+    const test::ProcessResult result = test::runProcess(SHAPEDB_CLI, args);
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find(folder + ": is a directory"), std::string::npos) << result.err;
+  }
 }
 
 }  // namespace
