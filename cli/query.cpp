@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include <shapedb/core/descriptor.h>
+#include <shapedb/core/error_model.h>
 #include <shapedb/io/database.h>
 #include <shapedb/io/enrich.h>
 #include <shapedb/io/mesh_io.h>
@@ -167,7 +168,9 @@ void printText(const std::string& file, const core::TriangleMesh& mesh, const io
                 p.collision.overshoot);
     const Eigen::VectorXd hz = p.frequenciesHz();
     if (r.predictedFrequencyError)
-      std::printf("    predicted first-frequency error: about %.0f %% (from %s)\n",
+      std::printf(*r.predictedFrequencyError < core::kMaxPredictedError
+                      ? "    predicted first-frequency error: about %.0f %% (from %s)\n"
+                      : "    predicted first-frequency error: %.0f %% or more: far off (from %s)\n",
                   100.0 * *r.predictedFrequencyError,
                   r.correction ? "the correction's morph and the fidelity report" : "the fidelity report");
     std::printf("    frequencies (Hz):");

@@ -52,7 +52,7 @@ double predictFrequencyError(const ErrorEvidence& evidence, const ErrorModel& mo
   double s = 0.0;
   for (int i = 0; i < kErrorFeatures; ++i)
     s += w[static_cast<std::size_t>(i)] * f[static_cast<std::size_t>(i)];
-  return std::exp(s);
+  return std::min(std::exp(s), kMaxPredictedError);
 }
 
 }  // namespace shapedb::core

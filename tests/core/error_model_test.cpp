@@ -56,6 +56,21 @@ TEST(ErrorModel, ThePredictionIsTheExponentialOfTheWeightedFeaturesOfItsKind) {
   EXPECT_NEAR(predictFrequencyError(e, model), 0.02 * std::sqrt(0.004) * 1.5 * 1.5 * std::exp(0.3), 1e-15);
 }
 
+TEST(ErrorModel, FarPastItsDataTheEstimateSaysFarOffAndNoMore) {
+  // Tets that hold a quarter of the query and lie almost all outside it (a round tray): the line in the
+  // logarithm gave 5,851 (585,100 %).
+  ErrorEvidence e;
+  e.morphTargetDistance = 0.02;
+  e.massScale = 0.23;
+  e.strayShare = 0.95;
+  EXPECT_EQ(predictFrequencyError(e), kMaxPredictedError);
+  ErrorModel model;
+  model.nearest = {std::log(0.5), 0, 0, 0, 0, 0, 0, 0, 0};
+  EXPECT_NEAR(predictFrequencyError(ErrorEvidence{}, model), 0.5, 1e-15);  // under the cap: as it was
+  model.nearest[0] = std::log(50.0);
+  EXPECT_EQ(predictFrequencyError(ErrorEvidence{}, model), kMaxPredictedError);
+}
+
 TEST(ErrorModel, TheShippedModelGrowsWithTheTetsACorrectedAnswerStraysAcrossGaps) {
   // The trend the real meshes show most clearly (docs/accuracy.md): the more of the morphed tets lie
   // outside the query (across a gap it has), the larger the corrected answer's error.

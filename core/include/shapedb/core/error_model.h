@@ -50,8 +50,14 @@ struct ErrorModel {
 /// docs/accuracy.md, "Predicted error"; refit with bench/error_model_fit.cpp).
 const ErrorModel& defaultErrorModel();
 
-/// exp(w · f), the weights chosen by whether the evidence is of a corrected answer: the predicted
-/// magnitude of the first non-rigid frequency's relative error (0.1: 10 %).
+/// The largest estimate made: 10, an error of 1,000 %. The model is a straight line in the logarithm,
+/// fitted on errors up to about 7 (+693 %, a knot); far past its data (tets that hold a quarter of the
+/// query and lie almost all outside it) the line gave thousands, which only meant "far off".
+inline constexpr double kMaxPredictedError = 10.0;
+
+/// exp(w · f), the weights chosen by whether the evidence is of a corrected answer, at most
+/// kMaxPredictedError: the predicted magnitude of the first non-rigid frequency's relative error (0.1:
+/// 10 %).
 double predictFrequencyError(const ErrorEvidence& evidence, const ErrorModel& model = defaultErrorModel());
 
 }  // namespace shapedb::core
