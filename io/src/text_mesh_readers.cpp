@@ -77,12 +77,22 @@ Result<RawPolygons> readObj(const std::filesystem::path& path) {
   if (!in) return Error{ErrorCode::kIo, path.string() + ": cannot read file"};
   RawPolygons raw;
   std::string line;
-  std::size_t number = 0;
+  std::size_t number = 0, statement = 0;  // the line read last, and the one the statement starts on
   auto fail = [&](ErrorCode code, const std::string& message) {
-    return Error{code, path.string() + ": line " + std::to_string(number) + ": " + message};
+    return Error{code, path.string() + ": line " + std::to_string(statement) + ": " + message};
   };
   while (std::getline(in, line)) {
-    ++number;
+    statement = ++number;
+    // A backslash at the end of a line continues the statement on the next (the format allows it; long
+    // face lines are written so). Errors name the statement's first line.
+    for (std::string next;;) {
+      const std::size_t end = line.find_last_not_of(" \t\r");
+      if (end == std::string::npos || line[end] != '\\' || !std::getline(in, next)) break;
+      ++number;
+      line.resize(end);  // the backslash and what follows it
+      line += ' ';
+      line += next;
+    }
     Words words(line);
     std::string_view keyword;
     if (!words.next(keyword)) continue;

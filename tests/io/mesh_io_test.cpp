@@ -78,6 +78,18 @@ TEST(MeshIo, TriangulatesPolygons) {
   EXPECT_EQ(loaded.polygonsTriangulated, 6u);
   EXPECT_TRUE(loaded.topology.isClosed());
   EXPECT_NEAR(volumeOf(loaded.mesh), 1.0, 1e-15);
+
+  // The same with statements continued on the next line by a backslash, as the format allows, and an
+  // error in one named by the line it starts on.
+  test::writeFile(dir / "continued.obj",
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 \\\r\n1\n"
+                  "f 1 3 \\\n4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 \\  \n  8 \\\n6\n");
+  const LoadedMesh continued = mustLoad(dir / "continued.obj");
+  EXPECT_EQ(continued.mesh.triangles.size(), 12u);
+  EXPECT_NEAR(volumeOf(continued.mesh), 1.0, 1e-15);
+  test::writeFile(dir / "continued_bad.obj", "v 0 0 0\nv 1 0 \\\n0\nv 0 1 \\\nnan\n");
+  const Error bad = mustFail(dir / "continued_bad.obj");
+  EXPECT_NE(bad.message.find("line 4: non-finite number 'nan'"), std::string::npos) << bad.message;
 }
 
 TEST(MeshIo, KeepsNonManifoldFacesForTheTopologyReport) {
