@@ -45,7 +45,8 @@ int runFracture(const FractureCommandOptions& o) {
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
-      "%s: %zu fragments from %d seeds (seed %llu, resolution %d, voxel %.4g m) in %.2f s, written to %s\n",
+      "%s: %zu fragments from %d seeds (seed %llu, resolution %d, voxel %.4g m) in %.2f s, written to %s "
+      "(in metres)\n",
       o.mesh.c_str(), pieces->fragments.size(), o.fracture.pieces,
       static_cast<unsigned long long>(o.fracture.seed), pieces->resolution, pieces->voxelSize, seconds,
       o.out.c_str());
@@ -112,7 +113,8 @@ Command addFractureCommand(CLI::App& parent) {
       "Break a closed mesh into fragments, as a fracture would: the solid becomes an OpenVDB level set, N\n"
       "random seeds inside it define Voronoi cells, and each cell's level set is intersected with it (a\n"
       "cell that cuts a non-convex solid in two gives two fragments). Fragments are closed meshes in the\n"
-      "mesh's frame, largest first, with voxel-scale detail on the cuts; crumbs under 1e-4 of the volume\n"
+      "mesh's frame and in metres (a mesh read with --units is converted: query the fragments without\n"
+      "it), largest first, with voxel-scale detail on the cuts; crumbs under 1e-4 of the volume\n"
       "are dropped. Deterministic per seed. 200 pieces of a plate take about 2 s.");
   app->add_option("MESH", o->mesh, "Closed surface mesh (.obj, .ply, .off, .stl, .gltf, .glb, .fbx, .dae)")
       ->required();
