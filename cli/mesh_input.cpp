@@ -94,7 +94,13 @@ Result<io::LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadFlags
   if (flags.units.empty() && !loaded->mesh.vertices.empty()) {
     const core::Bounds bounds = core::computeBounds(loaded->mesh);
     const double size = (bounds.max - bounds.min).maxCoeff();
-    if (size > 10.0) {
+    if (size > 1e4) {  // millimetres would still leave it over 10 m
+      std::snprintf(line, sizeof line,
+                    "the mesh is %.4g km across, read in metres; if that is not its unit, give --units or "
+                    "--scale",
+                    size * 1e-3);
+      messages.push_back("shapedb: warning: " + path + ": " + line);
+    } else if (size > 10.0) {
       std::snprintf(line, sizeof line,
                     "the mesh is %.4g m across, read in metres; if its unit is millimetres (as CAD exports "
                     "often are), give --units mm (inches: --units in)",

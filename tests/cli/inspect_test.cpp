@@ -172,6 +172,14 @@ TEST(CliInspect, AMillimetreMeshIsReadInItsUnitOrWarnedAbout) {
   ASSERT_EQ(scaled.exitCode, 0) << scaled.err;
   EXPECT_EQ(nlohmann::json::parse(scaled.out)["volume"], j["volume"]);
   EXPECT_NE(shapedb({"inspect", (dir / "tray.ply").string(), "--units", "furlong"}).exitCode, 0);
+
+  // 20 km across: millimetres would still leave it 20 m, so no unit is offered, only that it may be wrong.
+  ASSERT_TRUE(io::saveMesh(core::makeBox({2e4, 1e4, 5e3}), dir / "huge.ply").ok());
+  const test::ProcessResult huge = shapedb({"inspect", (dir / "huge.ply").string(), "--json"});
+  ASSERT_EQ(huge.exitCode, 0) << huge.err;
+  EXPECT_NE(huge.err.find("20 km across, read in metres; if that is not its unit, give --units or --scale"),
+            std::string::npos)
+      << huge.err;
 }
 
 TEST(CliInspect, HelpExplains) {
