@@ -19,14 +19,14 @@ double secondsSince(Clock::time_point start) {
 }
 
 // `mass` shared among the nodes of `tets` next to where `target` lies outside them (MorphedEntry::
-// pointMasses); empty if no vertex of the target lies outside.
+// pointMasses); empty if no sample of the target lies outside.
 std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::View& target, double mass) {
-  const std::vector<double>& area = target.target().vertexAreas();
+  const std::vector<double>& area = target.target().sampleAreas();
   const core::TetLocator locator(tets);
   core::TetLocator::Hint hint;
   std::vector<double> share(tets.nodeCount(), 0.0);
-  for (std::size_t v = 0; v < target.vertexCount(); ++v) {
-    const core::TetLocation at = locator.locate(target.vertex(v), hint);
+  for (std::size_t v = 0; v < target.sampleCount(); ++v) {
+    const core::TetLocation at = locator.locate(target.sample(v), hint);
     if (at.inside() || area[v] == 0.0) continue;
     const double gap = area[v] * at.distance;
     // The closest point is on a boundary face of at.tet: the node across from it has weight 0, to
@@ -82,9 +82,10 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const MorphTarg
   // The morphed tets fill the target only as far as the projection went: a boundary node held back off a
   // sharp edge cuts the edge or the corner, and a part the entry has no tets for is left out. What is
   // cut off is at the body's rim, mass where a mode moves most and little stiffness (a free edge carries
-  // no stress). So its mass is given back where it is missing, and not its volume: the target's
-  // vertices that lie outside the tets, each with a third of its triangles' area times its distance to
-  // them, share the missing mass among the corners of the boundary faces nearest to them. Scaling the tets
+  // no stress). So its mass is given back where it is missing, and not its volume: the target's samples
+  // that lie outside the tets (MorphTarget::sampleAreas: over its faces, not only at its corners), each
+  // with its area times its distance to them, share the missing mass among the corners of the boundary
+  // faces nearest to them. Scaling the tets
   // up to the target's volume, as before, thickened the whole body, stiffness with the mass, and left the
   // corrected first frequencies higher (docs/architecture.md).
   const std::optional<core::MassProperties>& targetMass = target.target().massProperties();

@@ -106,9 +106,9 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
   const SparseMatrix k = stiffness.assemble(start);
   const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
   const std::vector<double> nodeArea = boundaryAreas(boundary, start);
-  // The target's side: up to 2,000 of its vertices, each with its share of the target's area.
-  const std::vector<double>& vertexArea = target.target().vertexAreas();
-  const std::size_t stride = std::max<std::size_t>(1, target.vertexCount() / 2000);
+  // The target's side: up to 2,000 of its samples, each with its share of the target's area.
+  const std::vector<double>& sampleArea = target.target().sampleAreas();
+  const std::size_t stride = std::max<std::size_t>(1, target.sampleCount() / 2000);
   double stiffnessScale = 0.0, fitScale = 0.0;
   for (Eigen::Index i = 0; i < n; ++i)
     stiffnessScale += k.coeff(i, i);
@@ -121,7 +121,7 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
   SparseMatrix a = k;
   // Per target point, the boundary face its closest point was last found on: the faces keep their
   // numbering from round to round.
-  std::vector<std::uint32_t> onBoundary((target.vertexCount() + stride - 1) / stride, MorphTarget::kNoHint);
+  std::vector<std::uint32_t> onBoundary((target.sampleCount() + stride - 1) / stride, MorphTarget::kNoHint);
   for (int round = 0; round < rounds; ++round) {
     // From stiff (the fit moves the body nearly as a whole) to close: w from 0.1 to 100 times the
     // stiffness, in equal ratios.
@@ -168,13 +168,13 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
       return surface;
     }();
     const core::ClosestPointTree currentTree(current);
-    for (std::size_t v = 0, i = 0; v < target.vertexCount(); v += stride, ++i) {
-      const Vec3 point = target.vertex(v);
+    for (std::size_t v = 0, i = 0; v < target.sampleCount(); v += stride, ++i) {
+      const Vec3 point = target.sample(v);
       if (onBoundary[i] == MorphTarget::kNoHint && i > 0) onBoundary[i] = onBoundary[i - 1];
       const core::ClosestPointTree::Hit hit = currentTree.closest(point, onBoundary[i]);
       onBoundary[i] = hit.triangle;
       const auto& t = current.triangles[hit.triangle];
-      addPoint(t, hit.closest.barycentric, point, w * vertexArea[v] * static_cast<double>(stride));
+      addPoint(t, hit.closest.barycentric, point, w * sampleArea[v] * static_cast<double>(stride));
     }
     if (!inPattern) break;  // cannot be: two nodes of a boundary face share its tet
     // Every round's A has K's sparsity: the first round's analysis serves them all.
@@ -223,7 +223,31 @@ Result<MorphTarget> MorphTarget::prepare(core::TriangleMesh surface) {
   } else {
     out.mTree = core::ClosestPointTree(surface);
   }
-  out.mVertexAreas = core::vertexAreaWeights(surface);
+  out.mSamples = surface.vertices;
+  out.mSampleAreas = core::vertexAreaWeights(surface);
+  double total = 0.0;
+  for (const double a : out.mSampleAreas)
+    total += a;
+  const double largest = total / kSampledArea;
+  for (const core::TriangleMesh::Triangle& t : surface.triangles) {
+    const Vec3 &a = surface.vertices[t[0]], &b = surface.vertices[t[1]], &c = surface.vertices[t[2]];
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    if (!(area > largest)) continue;
+    // n² small triangles of area ≤ largest; a point's share is a third of its small triangles' area: one
+    // at a corner, three along an edge, six inside.
+    const int n = static_cast<int>(std::ceil(std::sqrt(area / largest)));
+    const double third = area / (3.0 * n * n);
+    for (const std::uint32_t corner : t)
+      out.mSampleAreas[corner] -= area / 3.0 - third;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const int onEdges = (i == 0) + (j == 0) + (i + j == n);
+        if (onEdges == 2) continue;  // a corner: the vertex itself
+        out.mSamples.push_back(a + (static_cast<double>(i) / n) * (b - a) +
+                               (static_cast<double>(j) / n) * (c - a));
+        out.mSampleAreas.push_back((onEdges == 1 ? 3.0 : 6.0) * third);
+      }
+  }
   out.mSurface = std::move(surface);
   return out;
 }
@@ -366,7 +390,7 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
   out.report.worstQuality = worstQuality(out.mesh);
 
   // How far the boundary went, prestretch included, and how much of the target it leaves out (over at
-  // most 2,000 of the target's vertices).
+  // most 2,000 of the target's samples, by their areas).
   double sum = 0.0;
   for (std::uint32_t node : boundary.nodes) {
     const double d = (out.mesh.nodes[node] - mesh.nodes[node]).norm();
@@ -376,16 +400,17 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
   out.report.meanBoundaryMove =
       boundary.nodes.empty() ? 0.0 : sum / static_cast<double>(boundary.nodes.size());
   const core::ClosestPointTree morphed(core::boundarySurface(out.mesh));
-  const std::size_t stride = std::max<std::size_t>(1, target.vertexCount() / 2000);
-  double distance = 0.0;
-  std::size_t count = 0;
-  std::uint32_t near = MorphTarget::kNoHint;  // the previous point's face: the target's vertices come in runs
-  for (std::size_t v = 0; v < target.vertexCount(); v += stride, ++count) {
-    const core::ClosestPointTree::Hit hit = morphed.closest(target.vertex(v), near);
+  const std::size_t stride = std::max<std::size_t>(1, target.sampleCount() / 2000);
+  const std::vector<double>& sampleArea = target.target().sampleAreas();
+  double distance = 0.0, sampled = 0.0;
+  std::uint32_t near = MorphTarget::kNoHint;  // the previous point's face: the target's samples come in runs
+  for (std::size_t v = 0; v < target.sampleCount(); v += stride) {
+    const core::ClosestPointTree::Hit hit = morphed.closest(target.sample(v), near);
     near = hit.triangle;
-    distance += std::sqrt(hit.closest.squaredDistance);
+    distance += sampleArea[v] * std::sqrt(hit.closest.squaredDistance);
+    sampled += sampleArea[v];
   }
-  out.report.meanTargetDistance = distance / static_cast<double>(count);
+  out.report.meanTargetDistance = sampled > 0.0 ? distance / sampled : 0.0;
   return out;
 }
 

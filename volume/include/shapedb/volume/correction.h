@@ -90,8 +90,9 @@ struct MorphedEntry {
   CorrectionReport report;
   /// Per node of tetMesh, the mass lumped there (unit density; ModalOptions::pointMasses): the target's
   /// volume the tets lack, shared among the boundary nodes next to where the target lies outside them, in
-  /// proportion to the area there times how far outside. Empty where the tets hold at least the target's
-  /// volume (their density is then lowered to give its mass) or nothing of the target lies outside them.
+  /// proportion to the area there times how far outside (over MorphTarget's samples of the target). Empty
+  /// where the tets hold at least the target's volume (their density is then lowered to give its mass) or
+  /// nothing of the target lies outside them.
   std::vector<double> pointMasses;
 };
 

@@ -44,8 +44,9 @@ struct MorphReport {
   double worstQuality = 0.0;                ///< after it
   double maxBoundaryMove = 0.0;             ///< largest move of a boundary node, prestretch included
   double meanBoundaryMove = 0.0;
-  /// Mean distance from the target's vertices to the morphed boundary: how much of the target the morphed
-  /// mesh does not reach (a handle the entry has no material for, say).
+  /// Mean distance from the target's surface to the morphed boundary (over MorphTarget's samples, by their
+  /// areas): how much of the target the morphed mesh does not reach (a handle the entry has no material
+  /// for, say).
   double meanTargetDistance = 0.0;
   int increments = 0;  ///< increments of the final projection
   /// The share of the final projection onto the target that was taken, weighted by area (1: the whole
@@ -80,8 +81,22 @@ class MorphTarget {
   /// At unit density; empty where the surface bounds no solid (open, or wound inward), which has no
   /// volume, no moments and no inside.
   const std::optional<core::MassProperties>& massProperties() const { return mMass; }
-  /// Per vertex, a third of the area of its triangles (core::vertexAreaWeights).
-  const std::vector<double>& vertexAreas() const { return mVertexAreas; }
+  /// The surface as points that each stand for a part of its area, what the morph measures the target
+  /// by (its fit's correspondences from the target's side, how closely the morph reaches it, where its
+  /// missing mass goes): the vertices, each with a third of the area of its triangles, and where a triangle
+  /// holds more than 1/kSampledArea of the surface's area, the points of a regular subdivision of it into
+  /// n² triangles of at most that area, each with a third of the area of its small triangles (the
+  /// triangle's corners then keep a third of one small triangle's). A surface of small triangles (a scan, a
+  /// fragment) is its vertices, as before there were samples; a low-poly one (a tetrahedron, a box of
+  /// twelve triangles, a game prop) is sampled over its faces as well, not only at its corners, where the
+  /// mass its morph misses used to go all at once. The areas sum to the surface's.
+  std::size_t sampleCount() const { return mSamples.size(); }
+  const std::vector<double>& sampleAreas() const { return mSampleAreas; }
+  /// Triangles over 1/kSampledArea of the surface's area are subdivided for the samples. A hundredth
+  /// leaves meshes of hundreds of triangles or more as they were; a thousandth also subdivided fragments'
+  /// flat cuts, and their corrected answers came out a point lower (docs/architecture.md, "Low-poly
+  /// surfaces").
+  static constexpr double kSampledArea = 100.0;
 
   /// The target as a mesh in another frame sees it: `frame` (orthogonal) carries a point of the target's
   /// frame into the mesh's. Holds the target by reference.
@@ -89,8 +104,9 @@ class MorphTarget {
    public:
     View(const MorphTarget& target, const core::Mat3& frame) : mTarget(&target), mFrame(frame) {}
     const MorphTarget& target() const { return *mTarget; }
-    std::size_t vertexCount() const { return mTarget->mSurface.vertices.size(); }
-    core::Vec3 vertex(std::size_t v) const { return mFrame * mTarget->mSurface.vertices[v]; }
+    std::size_t sampleCount() const { return mTarget->mSamples.size(); }
+    /// Sample i (MorphTarget::sampleAreas), in the mesh's frame.
+    core::Vec3 sample(std::size_t i) const { return mFrame * mTarget->mSamples[i]; }
     core::Vec3 closestPoint(const core::Vec3& p) const;
     /// The same, the search started from the target's triangle `near` (the one found for a nearby point,
     /// or for this point before it moved; kNoHint for none), which is then set to the triangle found: the
@@ -119,7 +135,8 @@ class MorphTarget {
   const core::ClosestPointTree& tree() const { return mMass ? mSide.tree() : mTree; }
   core::TriangleMesh mSurface;
   std::optional<core::MassProperties> mMass;
-  std::vector<double> mVertexAreas;
+  std::vector<core::Vec3> mSamples;  ///< the vertices first, in order, then the subdivisions' points
+  std::vector<double> mSampleAreas;
   core::SurfaceSide mSide;       ///< built where the surface bounds a solid; its tree serves the searches
   core::ClosestPointTree mTree;  ///< built only where it does not
 };
