@@ -61,18 +61,27 @@ TEST(Fracture, FragmentsAreClosedSolidsThatFillThePlateAndSphere) {
   }
 }
 
-TEST(Fracture, AMeshFarFromTheOriginBreaksAsAtTheOrigin) {
-  // Scans and CAD exports sit hundreds of metres (or kilometres) from the origin: single-precision level
-  // sets there tore fragments open and dropped them. Up to the offset, the fragments are the same.
-  const core::TriangleMesh pebble = core::transformed(core::makeIcosphere(0.05, 3), [] {
-    core::Mat4 m = core::Mat4::Identity();
-    m.diagonal().head<3>() = Vec3(1.6, 1.0, 0.7);
-    return m;
-  }());
+/// A lopsided pebble 16 × 10 × 7 cm, and twelve pieces of it at a fixed resolution: the solid the tests of
+/// where and how large a mesh is break.
+core::TriangleMesh flatPebble() {
+  core::Mat4 m = core::Mat4::Identity();
+  m.diagonal().head<3>() = Vec3(1.6, 1.0, 0.7);
+  return core::transformed(core::makeIcosphere(0.05, 3), m);
+}
+
+FractureOptions pebbleOptions() {
   FractureOptions options;
   options.pieces = 12;
   options.seed = 5;
   options.resolution = 64;
+  return options;
+}
+
+TEST(Fracture, AMeshFarFromTheOriginBreaksAsAtTheOrigin) {
+  // Scans and CAD exports sit hundreds of metres (or kilometres) from the origin: single-precision level
+  // sets there tore fragments open and dropped them. Up to the offset, the fragments are the same.
+  const core::TriangleMesh pebble = flatPebble();
+  const FractureOptions options = pebbleOptions();
   const Result<FractureResult> here = fracture(pebble, options);
   ASSERT_TRUE(here.ok()) << here.error().message;
   EXPECT_EQ(here->openDropped, 0u);
@@ -103,15 +112,8 @@ TEST(Fracture, AMeshOfAnySizeBreaksAsAtItsOwn) {
   // A part read in the wrong unit is microns across (or kilometres): OpenVDB refuses voxels that small
   // ("Non-zero scale values required"), so fracture works in a frame of the mesh's own size. Up to the
   // scale, the fragments are the same.
-  const core::TriangleMesh pebble = core::transformed(core::makeIcosphere(0.05, 3), [] {
-    core::Mat4 m = core::Mat4::Identity();
-    m.diagonal().head<3>() = Vec3(1.6, 1.0, 0.7);
-    return m;
-  }());
-  FractureOptions options;
-  options.pieces = 12;
-  options.seed = 5;
-  options.resolution = 64;
+  const core::TriangleMesh pebble = flatPebble();
+  const FractureOptions options = pebbleOptions();
   const Result<FractureResult> here = fracture(pebble, options);
   ASSERT_TRUE(here.ok()) << here.error().message;
   for (const double scale : {1e-7, 1e-4, 1e4}) {
