@@ -152,6 +152,7 @@ std::pair<TriangleMesh, Meshing> closedSurface(const openvdb::FloatGrid& grid, d
     Result<TriangleMesh> simpler = simplify(centred, simplifyOptions);
     if (!simpler.ok() || !isClosedSolid(*simpler)) break;
     if (!faithful(*simpler, simplifyOptions.maxError)) continue;
+    if (options.uncrossed && !core::findSelfIntersections(*simpler).empty()) break;
     for (Vec3& p : simpler->vertices)
       p += centre;
     return {std::move(simpler).value(), meshing};
@@ -338,18 +339,11 @@ Result<RepairedSurface> repairSurface(const TriangleMesh& mesh, const RepairOpti
                                             -static_cast<float>(bandVoxels * h));
   solid->setTransform(transform);
 
+  // Unsimplified where the simplification would make it pass through itself: a repaired surface that
+  // still did would need repairing again.
   auto [surface, meshing] = detail::closedSurface(
-      *solid, h, detail::SurfaceOptions{.maxTriangles = options.maxTriangles, .simplifyError = 0.25});
-  // The simplification can fold two sheets of a thin wall through each other, which the crossing of a
-  // level set never does: then the crossing stands, unsimplified (a repaired surface that still passed
-  // through itself would need repairing again).
-  if (meshing != detail::Meshing::kOpen && !core::findSelfIntersections(surface).empty()) {
-    auto [raw, rawMeshing] = detail::closedSurface(*solid, h, detail::SurfaceOptions{.maxTriangles = 0});
-    if (rawMeshing != detail::Meshing::kOpen && !raw.triangles.empty()) {
-      surface = std::move(raw);
-      meshing = rawMeshing;
-    }
-  }
+      *solid, h,
+      detail::SurfaceOptions{.maxTriangles = options.maxTriangles, .simplifyError = 0.25, .uncrossed = true});
   if (surface.triangles.empty() || meshing == detail::Meshing::kOpen)
     return Error{ErrorCode::kParse,
                  "no closed surface came out of the repair: the mesh encloses nothing that its holes "

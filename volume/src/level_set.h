@@ -42,6 +42,11 @@ enum class Meshing {
 struct SurfaceOptions {
   std::size_t maxTriangles = 3000;
   double simplifyError = 0.25;
+  /// Refuse a simplification that makes the surface pass through itself (two sheets of a thin wall folded
+  /// together; a level set's crossing never does): the crossing then stands, unsimplified. The repair's
+  /// (one surface); not fracture's, which meshes hundreds of fragments at once and would pay the
+  /// self-intersection search for each.
+  bool uncrossed = false;
 };
 
 /// The grid's zero crossing as an outward-wound triangle mesh, closed where it can be, then simplified.
