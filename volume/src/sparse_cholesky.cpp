@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cholmod.h>
+#if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
+#endif
 #include <cstring>
 #include <dlfcn.h>
 #include <limits>
@@ -99,12 +102,31 @@ struct CallGuard {
 
 }  // namespace
 
+namespace {
+
+/// The processor's family as CPUID reports it (the base family, plus the extended one where the base is
+/// 15); 0 where it cannot be read.
+unsigned cpuFamily() {
+#if defined(__x86_64__) || defined(__i386__)
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  if (__get_cpuid(1, &a, &b, &c, &d) == 0) return 0;
+  const unsigned base = (a >> 8) & 0xFu;
+  return base == 0xFu ? base + ((a >> 20) & 0xFFu) : base;
+#else
+  return 0;
+#endif
+}
+
+}  // namespace
+
 double supernodalSwitch() {
   // The header says where these were measured.
-  constexpr double kOpenBlasIntel = 40.0, kOpenBlas = 135.0, kOtherBlas = 175.0;
+  constexpr double kOpenBlasSmallBlocks = 40.0, kOpenBlas = 135.0, kOtherBlas = 175.0;
+  constexpr unsigned kZen5 = 0x1A;
   if (!openBlasParallel()) return kOtherBlas;
 #if defined(__x86_64__) || defined(__i386__)
-  if (__builtin_cpu_is("intel")) return kOpenBlasIntel;
+  if (__builtin_cpu_is("intel") || (__builtin_cpu_is("amd") && cpuFamily() >= kZen5))
+    return kOpenBlasSmallBlocks;
 #endif
   return kOpenBlas;
 }

@@ -34,9 +34,12 @@ enum class CholeskyMethod { kAuto, kSimplicial, kSupernodal };
 /// cost per call on small blocks is low), 135 on an AMD EPYC
 /// (bench/results/epyc-2core/factorization_2026-11-28.md) and CHOLMOD's own default, 40, on an Intel Xeon,
 /// where the supernodal method factorizes the slender entries 1.5-2× faster than on the EPYC and the
-/// simplicial one no faster (bench/results/xeon-2core/supernodal_switch_2026-11-29.md): Intel processors
-/// take 40, any other 135. With any other BLAS (BLIS, the reference BLAS: the slender entries and the
-/// registration's systems, 74-152, are then 1.5-6× faster column by column), 175.
+/// simplicial one no faster (bench/results/xeon-2core/supernodal_switch_2026-11-29.md), and on an AMD
+/// EPYC of the Zen 5 family, where 40 took a geometry correction's median 9 % lower than 135 and left a
+/// database build's time as it was (bench/results/zen5-2core/supernodal_switch_2026-11-30.md): Intel
+/// processors and AMD ones from Zen 5 on take 40, any other 135. With any other BLAS (BLIS, the reference
+/// BLAS: the slender entries and the registration's systems, 74-152, are then 1.5-6× faster column by
+/// column), 175.
 double supernodalSwitch();
 
 class SparseCholesky {
