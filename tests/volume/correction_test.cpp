@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -13,10 +15,12 @@
 #include <shapedb/core/spatial.h>
 #include <shapedb/volume/correction.h>
 #include <shapedb/volume/entry.h>
+#include <shapedb/volume/families.h>
 #include <shapedb/volume/modal.h>
 #include <shapedb/volume/morph.h>
 #include <shapedb/volume/tetrahedralize.h>
 
+#include "point_masses.h"
 #include "synthetic.h"
 
 namespace shapedb::volume {
@@ -260,6 +264,123 @@ TEST(Correction, TheMassTheMorphMissesIsLumpedWhereTheTargetLiesOutside) {
   Result<core::ModalData> bare = computeModesFrom(mesh, entry.modes.shapes, modalOptions(4));
   ASSERT_TRUE(bare.ok()) << bare.error().message;
   EXPECT_LT(corrected->physics.modes.eigenvalues[0], bare->eigenvalues[0]);
+}
+
+// A fracture fragment's entry morphed onto a regular tetrahedron: its tets reach towards the sharp
+// corners in slivers, and a corner's missing mass goes to the nodes nearest it, a sliver's tip among them.
+// By weight alone such a tip took up to 266 times its own mass here (pointMassPeak); no node takes more
+// than kPointMassLimit times it, and the mass placed is still all the tets lack. (The corrected first
+// frequencies are printed, not checked: in these arbitrary orientations they are 25-77 % below the
+// tetrahedron's own, with no warning; docs/architecture.md, "The mass the morph misses".)
+TEST(Correction, NoNodeTakesMoreOfTheMissingMassThanItsLimit) {
+  Result<core::TriangleMesh> shape = makeFamilyShape(familySpec(Family::kFragment, 32));
+  ASSERT_TRUE(shape.ok()) << shape.error().message;
+  core::TriangleMesh surface = std::move(shape).value();
+  const core::MassProperties props = *core::computeMassProperties(surface);
+  const double scale = 1.0 / std::cbrt(props.volume);
+  for (Vec3& p : surface.vertices)
+    p = scale * (p - props.centerOfMass);
+  const core::PhysicalData entry = entryData(surface, 6);
+  ASSERT_EQ(entry.modes.modeCount(), 6u);
+  const double edge = std::cbrt(6.0 * std::sqrt(2.0));  // a regular tetrahedron of unit volume
+  const double a = edge / (2.0 * std::sqrt(2.0));
+  std::mt19937_64 rng(5);
+  double highestPeak = 0.0;
+  for (int trial = 0; trial < 6; ++trial) {
+    SCOPED_TRACE(trial);
+    const core::Mat3 r = test::randomRotation(rng);
+    const core::TriangleMesh tetrahedron = core::makeTetrahedron(r * Vec3(a, a, a), r * Vec3(a, -a, -a),
+                                                                 r * Vec3(-a, a, -a), r * Vec3(-a, -a, a));
+    Result<MorphedEntry> morphed = morphEntry(entry, tetrahedron);
+    ASSERT_TRUE(morphed.ok()) << morphed.error().message;
+    const TetMesh& mesh = morphed->tetMesh;
+    std::vector<double> own(mesh.nodeCount(), 0.0);
+    for (std::size_t t = 0; t < mesh.tetCount(); ++t)
+      for (const std::uint32_t n : mesh.tets[t])
+        own[n] += 0.25 * std::abs(core::tetVolume(mesh, t));
+    const double volume = std::accumulate(own.begin(), own.end(), 0.0);
+    ASSERT_EQ(morphed->pointMasses.size(), mesh.nodeCount());
+    EXPECT_NEAR(std::accumulate(morphed->pointMasses.begin(), morphed->pointMasses.end(), 0.0), 1.0 - volume,
+                1e-9);
+    // At most the limit, and, were every node near the corners at it, the rest spread by own mass.
+    for (std::size_t i = 0; i < mesh.nodeCount(); ++i)
+      EXPECT_LE(morphed->pointMasses[i], (kPointMassLimit + (1.0 - volume) / volume) * own[i] * (1.0 + 1e-9))
+          << "node " << i;
+    highestPeak = std::max(highestPeak, morphed->report.pointMassPeak);
+    Result<CorrectedEntry> corrected = correctMorphed(entry, *morphed, modalOptions(6));
+    ASSERT_TRUE(corrected.ok()) << corrected.error().message;
+    const core::PhysicalData direct = entryData(tetrahedron, 6);
+    std::printf(
+        "fragment onto a regular tetrahedron, turn %d: f1 %+.1f %% (mass scale %.3f, point mass peak "
+        "%.1f)\n",
+        trial,
+        100.0 * (std::sqrt(corrected->physics.modes.eigenvalues[0] / direct.modes.eigenvalues[0]) - 1.0),
+        morphed->report.massScale, morphed->report.pointMassPeak);
+  }
+  EXPECT_GT(highestPeak, 4.0 * kPointMassLimit);  // the limit held some node back
+}
+
+// The shares of the missing mass against a search for the same answer by bisection: λ such that
+// Σ min(λ wᵢ, L mᵢ) is the mass to place (L = kPointMassLimit), each node's share min(λ wᵢ, L mᵢ); or,
+// where even every weighted node at its limit is too little, those limits and the rest by own mass.
+TEST(Correction, TheMissingMassIsSharedByWeightAndNoNodeTakesPastItsLimit) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int limited = 0, overflowing = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::size_t n = 1 + rng() % 40;
+    std::vector<double> weights(n), own(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      weights[i] = unit(rng) < 0.3 ? 0.0 : std::pow(unit(rng), 4);  // some nodes unweighted, some far heavier
+      own[i] = std::pow(10.0, -4.0 * unit(rng));                    // own masses over four decades
+    }
+    double room = 0.0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (weights[i] > 0.0) room += kPointMassLimit * own[i];
+    const double mass = room * (trial % 5 == 0 ? 1.0 + unit(rng) : unit(rng));
+    const std::vector<double> shares = detail::limitedShares(weights, own, mass);
+    ASSERT_EQ(shares.size(), n);
+    const double weight = std::accumulate(weights.begin(), weights.end(), 0.0);
+    if (weight == 0.0) {
+      for (const double s : shares)
+        EXPECT_EQ(s, 0.0);
+      continue;
+    }
+    EXPECT_NEAR(std::accumulate(shares.begin(), shares.end(), 0.0), mass, 1e-12 * mass);
+    std::vector<double> expected(n, 0.0);
+    if (mass >= room) {
+      ++overflowing;
+      const double all = std::accumulate(own.begin(), own.end(), 0.0);
+      for (std::size_t i = 0; i < n; ++i)
+        expected[i] = (weights[i] > 0.0 ? kPointMassLimit * own[i] : 0.0) + (mass - room) * own[i] / all;
+    } else {
+      const auto placed = [&](double lambda) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < n; ++i)
+          sum += std::min(lambda * weights[i], kPointMassLimit * own[i]);
+        return sum;
+      };
+      double low = 0.0, high = 1.0;
+      while (placed(high) < mass)
+        high *= 2.0;
+      for (int step = 0; step < 200; ++step) {
+        const double mid = 0.5 * (low + high);
+        (placed(mid) < mass ? low : high) = mid;
+      }
+      bool atLimit = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        expected[i] = std::min(high * weights[i], kPointMassLimit * own[i]);
+        atLimit = atLimit || (weights[i] > 0.0 && high * weights[i] > kPointMassLimit * own[i]);
+        EXPECT_LE(shares[i], kPointMassLimit * own[i] * (1.0 + 1e-12));
+      }
+      limited += atLimit ? 1 : 0;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_NEAR(shares[i], expected[i], 1e-9 * mass) << "trial " << trial << ", node " << i;
+  }
+  // Both regimes were met, and some nodes were held at their limit.
+  EXPECT_GT(limited, 50);
+  EXPECT_GT(overflowing, 20);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <shapedb/core/spatial.h>
 #include <shapedb/volume/correction.h>
 
+#include "point_masses.h"
+
 namespace shapedb::volume {
 namespace {
 
@@ -18,9 +20,66 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// Each node's own mass at unit density: a quarter of every tet it is a corner of.
+std::vector<double> nodeMasses(const core::TetMesh& tets) {
+  std::vector<double> own(tets.nodeCount(), 0.0);
+  for (std::size_t t = 0; t < tets.tetCount(); ++t) {
+    const double quarter = 0.25 * std::abs(core::tetVolume(tets, t));
+    for (const std::uint32_t node : tets.tets[t])
+      own[node] += quarter;
+  }
+  return own;
+}
+
+}  // namespace
+
+namespace detail {
+
+std::vector<double> limitedShares(std::span<const double> weights, std::span<const double> own, double mass) {
+  // λ · weight for every node, but at most kPointMassLimit × own: the nodes whose limit is least for their
+  // weight reach it first, and each one that does leaves the rest to the others (water filling).
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < weights.size(); ++i)
+    if (weights[i] > 0.0) order.push_back(i);
+  std::vector<double> out(weights.size(), 0.0);
+  if (order.empty()) return out;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return own[a] * weights[b] < own[b] * weights[a]; });
+  // The weight of the nodes from the j-th on, summed from the last (no cancellation from subtracting).
+  std::vector<double> rest(order.size() + 1, 0.0);
+  for (std::size_t j = order.size(); j-- > 0;)
+    rest[j] = rest[j + 1] + weights[order[j]];
+  double placed = 0.0;
+  std::size_t full = 0;
+  for (; full < order.size(); ++full) {
+    const std::size_t i = order[full];
+    const double limit = kPointMassLimit * own[i];
+    if ((mass - placed) * weights[i] <= limit * rest[full]) break;
+    out[i] = limit;
+    placed += limit;
+  }
+  if (full < order.size()) {
+    for (std::size_t j = full; j < order.size(); ++j)
+      out[order[j]] = (mass - placed) * (weights[order[j]] / rest[full]);
+  } else {
+    // Every node at its limit: the rest over all the nodes by their own mass, as a uniform density would.
+    const double all = std::accumulate(own.begin(), own.end(), 0.0);
+    if (all > 0.0)
+      for (std::size_t i = 0; i < out.size(); ++i)
+        out[i] += (mass - placed) * (own[i] / all);
+  }
+  return out;
+}
+
+}  // namespace detail
+
+namespace {
+
 // `mass` shared among the nodes of `tets` next to where `target` lies outside them (MorphedEntry::
-// pointMasses); empty if no sample of the target lies outside.
-std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::View& target, double mass) {
+// pointMasses), none more than kPointMassLimit times its own; empty if no sample of the target lies
+// outside. `peak`: CorrectionReport::pointMassPeak.
+std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::View& target, double mass,
+                                double& peak) {
   const std::vector<double>& area = target.target().sampleAreas();
   const core::TetLocator locator(tets);
   core::TetLocator::Hint hint;
@@ -36,9 +95,11 @@ std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::Vi
   }
   const double total = std::accumulate(share.begin(), share.end(), 0.0);
   if (!(total > 0.0)) return {};
-  for (double& s : share)
-    s *= mass / total;
-  return share;
+  const std::vector<double> own = nodeMasses(tets);
+  peak = 0.0;
+  for (std::size_t i = 0; i < share.size(); ++i)
+    if (share[i] > 0.0) peak = std::max(peak, mass * share[i] / total / own[i]);
+  return detail::limitedShares(share, own, mass);
 }
 
 // CorrectionReport::strayShare: the volume of the tets whose centroid lies outside `target`, over all
@@ -105,7 +166,8 @@ void placeMissingMass(MorphedEntry& morphed, const MorphTarget::View& target) {
   if (!targetMass) return;
   const double volume = core::computeTetMassProperties(morphed.tetMesh).volume;
   if (std::isfinite(targetMass->volume / volume) && targetMass->volume > volume && volume > 0.0)
-    morphed.pointMasses = missingMass(morphed.tetMesh, target, targetMass->volume - volume);
+    morphed.pointMasses =
+        missingMass(morphed.tetMesh, target, targetMass->volume - volume, morphed.report.pointMassPeak);
 }
 
 std::vector<std::string> correctionWarnings(const CorrectionReport& report) {

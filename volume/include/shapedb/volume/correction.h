@@ -33,6 +33,11 @@ struct CorrectionReport {
   /// or more went with corrected answers 12-690 % off (docs/architecture.md). 0, unknown, where the
   /// target bounds no solid (an open surface has no inside).
   double strayShare = 0.0;
+  /// Of the mass the morph misses, the most that its placement by weight would give one node, over the
+  /// node's own mass (MorphedEntry::pointMasses; a node is given at most kPointMassLimit): large where
+  /// the missing mass is concentrated on a few light nodes, as at a sharp corner the tets do not reach.
+  /// 0 where no mass is missing.
+  double pointMassPeak = 0.0;
   int solves = 0;  ///< solves of the modes' recomputation (Lanczos, started from the entry's modes)
   /// Entries morphed to choose this one from (a query's candidates, io::QueryOptions::correctionCandidates);
   /// morphSeconds is all of their morphs', with the one preparation of the query's surface they share
@@ -58,6 +63,19 @@ inline constexpr double kStrayShareWarning = 0.1;
 /// meshes of the benchmarks the three corrected answers past it (mass scales 1.5, 1.8 and 3.1) were 31-45 %
 /// low; the others were at most 1.14, and so were all of 148 fracture fragments' (at most 1.08).
 inline constexpr double kMassScaleWarning = 1.25;
+
+/// The most mass the morph misses that one node of the morphed tets takes, as a multiple of its own mass
+/// (unit density: a quarter of each tet it is a corner of). The missing mass goes to the boundary nodes
+/// nearest where the target lies outside the tets; where a morph has pulled a sliver of tets out towards a
+/// sharp corner, the whole corner's share lands on the sliver's tip, a node of next to no mass held by next
+/// to no stiffness, which then rings on its own: a mode of the mesh that the object does not have, and the
+/// first. A node whose mass grows by a factor 1 + R rings √(1 + R) times lower; a default entry is some
+/// eight to ten tets across, so past R ≈ 16 (four times lower) such a node's own mode comes down among the
+/// body's first. What a node cannot take goes to the others by the same weights; what none can, to every
+/// node by its own mass. Measured (docs/architecture.md, "The mass the morph misses"): a regular
+/// tetrahedron corrected from a fragment entry, whose tip node had taken 263 times its mass, rang −38 %,
+/// and −1.5 % with the limit; of 148 fracture fragments and twelve real meshes, four answers changed.
+inline constexpr double kPointMassLimit = 16.0;
 
 /// What a query's answer says of a correction that may be far off (stray share over kStrayShareWarning,
 /// mass scale over kMassScaleWarning), one sentence each; empty for one that is not.
@@ -90,7 +108,8 @@ struct MorphedEntry {
   CorrectionReport report;
   /// Per node of tetMesh, the mass lumped there (unit density; ModalOptions::pointMasses): the target's
   /// volume the tets lack, shared among the boundary nodes next to where the target lies outside them, in
-  /// proportion to the area there times how far outside (over MorphTarget's samples of the target). Empty
+  /// proportion to the area there times how far outside (over MorphTarget's samples of the target), none
+  /// more than kPointMassLimit times its own mass while the others can take the rest. Empty
   /// where the tets hold at least the target's volume (their density is then lowered to give its mass) or
   /// nothing of the target lies outside them.
   std::vector<double> pointMasses;
