@@ -117,6 +117,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"projected", c.morph.projected},
           {"mass_scale", c.massScale},
           {"stray_share", c.strayShare},
+          {"point_mass_peak", c.pointMassPeak},
           {"morphs", c.morphs},
           {"fallback", c.fallback},
           {"solves", c.solves},

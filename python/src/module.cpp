@@ -170,13 +170,13 @@ py::dict fidelityDict(const core::Fidelity& f) {
 
 py::dict correctionDict(const volume::CorrectionReport& r) {
   const volume::MorphReport& m = r.morph;
-  return py::dict("stretch"_a = copyOf(m.stretch), "entry_worst_quality"_a = m.entryWorstQuality,
-                  "worst_quality"_a = m.worstQuality, "max_boundary_move"_a = m.maxBoundaryMove,
-                  "mean_boundary_move"_a = m.meanBoundaryMove,
-                  "mean_target_distance"_a = m.meanTargetDistance, "projected"_a = m.projected,
-                  "mass_scale"_a = r.massScale, "stray_share"_a = r.strayShare, "solves"_a = r.solves,
-                  "morphs"_a = r.morphs, "fallback"_a = r.fallback, "morph_seconds"_a = r.morphSeconds,
-                  "modes_seconds"_a = r.modesSeconds);
+  return py::dict(
+      "stretch"_a = copyOf(m.stretch), "entry_worst_quality"_a = m.entryWorstQuality,
+      "worst_quality"_a = m.worstQuality, "max_boundary_move"_a = m.maxBoundaryMove,
+      "mean_boundary_move"_a = m.meanBoundaryMove, "mean_target_distance"_a = m.meanTargetDistance,
+      "projected"_a = m.projected, "mass_scale"_a = r.massScale, "stray_share"_a = r.strayShare,
+      "point_mass_peak"_a = r.pointMassPeak, "solves"_a = r.solves, "morphs"_a = r.morphs,
+      "fallback"_a = r.fallback, "morph_seconds"_a = r.morphSeconds, "modes_seconds"_a = r.modesSeconds);
 }
 
 py::dict timesDict(const io::QueryTimes& t) {

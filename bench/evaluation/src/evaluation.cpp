@@ -5,6 +5,7 @@
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <string>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -315,6 +316,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
               m.morphTargetDistance = q.correction->morph.meanTargetDistance;
               m.massScale = q.correction->massScale;
               m.strayShare = q.correction->strayShare;
+              m.pointMassPeak = q.correction->pointMassPeak;
             }
             if (q.predictedFrequencyError) m.predictedError = *q.predictedFrequencyError;
             m.matchMicros = q.times.validate + q.times.massProperties + q.times.describe + q.times.search;
@@ -418,12 +420,12 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
   file << "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
           "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
           "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,"
-          "morph_target_distance,mass_scale,stray_share,predicted_error,status\n";
+          "morph_target_distance,mass_scale,stray_share,point_mass_peak,predicted_error,status\n";
   for (const FragmentEvaluation& e : evaluations) {
     const std::string head = csvField(e.name) + "," + std::to_string(e.triangles) + "," + number(e.volume) +
                              "," + std::to_string(e.truthTets) + "," + number(e.truthSeconds) + ",";
     if (e.methods.empty()) {
-      file << head << ",,,,,,,,,,,,,,,,,,,,,,,," << csvField(e.error) << "\n";
+      file << head << std::string(26, ',') << csvField(e.error) << "\n";
       continue;
     }
     for (const MethodEvaluation& m : e.methods) {
@@ -440,8 +442,8 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
            << number(m.meanDeviation) << "," << number(m.maxDeviation) << "," << number(m.maxMomentError)
            << "," << number(m.descriptorDistance) << "," << number(m.outsideShare) << ","
            << number(m.morphTargetDistance) << "," << number(m.massScale) << "," << number(m.strayShare)
-           << "," << number(m.predictedError) << "," << (e.ok() ? std::string("ok") : csvField(e.error))
-           << "\n";
+           << "," << number(m.pointMassPeak) << "," << number(m.predictedError) << ","
+           << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
     }
   }
   file.flush();

@@ -79,6 +79,7 @@ struct MethodEvaluation {
   double morphTargetDistance = kNaN;
   double massScale = kNaN;       ///< the corrected query: volume::CorrectionReport::massScale
   double strayShare = kNaN;      ///< the corrected query: volume::CorrectionReport::strayShare
+  double pointMassPeak = kNaN;   ///< the corrected query: volume::CorrectionReport::pointMassPeak
   double predictedError = kNaN;  ///< descriptors: the query's QueryResult::predictedFrequencyError
   double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link), fidelity
                               ///< report aside
