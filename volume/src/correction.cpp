@@ -98,7 +98,7 @@ std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::Vi
   const std::vector<double> own = nodeMasses(tets);
   peak = 0.0;
   for (std::size_t i = 0; i < share.size(); ++i)
-    if (share[i] > 0.0) peak = std::max(peak, mass * share[i] / total / own[i]);
+    if (share[i] > 0.0 && own[i] > 0.0) peak = std::max(peak, mass * share[i] / total / own[i]);
   return detail::limitedShares(share, own, mass);
 }
 

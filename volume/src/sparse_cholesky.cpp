@@ -100,22 +100,16 @@ struct CallGuard {
   SerialOpenMp openMp;
 };
 
-}  // namespace
-
-namespace {
-
+#if defined(__x86_64__) || defined(__i386__)
 /// The processor's family as CPUID reports it (the base family, plus the extended one where the base is
 /// 15); 0 where it cannot be read.
 unsigned cpuFamily() {
-#if defined(__x86_64__) || defined(__i386__)
   unsigned a = 0, b = 0, c = 0, d = 0;
   if (__get_cpuid(1, &a, &b, &c, &d) == 0) return 0;
   const unsigned base = (a >> 8) & 0xFu;
   return base == 0xFu ? base + ((a >> 20) & 0xFFu) : base;
-#else
-  return 0;
-#endif
 }
+#endif
 
 }  // namespace
 
