@@ -116,9 +116,9 @@ unsigned cpuFamily() {
 double supernodalSwitch() {
   // The header says where these were measured.
   constexpr double kOpenBlasSmallBlocks = 40.0, kOpenBlas = 135.0, kOtherBlas = 175.0;
-  constexpr unsigned kZen5 = 0x1A;
   if (!openBlasParallel()) return kOtherBlas;
 #if defined(__x86_64__) || defined(__i386__)
+  constexpr unsigned kZen5 = 0x1A;
   if (__builtin_cpu_is("intel") || (__builtin_cpu_is("amd") && cpuFamily() >= kZen5))
     return kOpenBlasSmallBlocks;
 #endif
