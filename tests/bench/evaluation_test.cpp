@@ -5,6 +5,8 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -183,6 +185,21 @@ TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
   const std::string text((std::istreambuf_iterator<char>(csv)), {});
   EXPECT_NE(text.find("open,"), std::string::npos);
   EXPECT_NE(text.find("query"), std::string::npos);
+  // Every row, the failed shape's too, has the header's fields (commas outside quotes).
+  std::istringstream lines(text);
+  std::vector<std::size_t> fields;
+  for (std::string line; std::getline(lines, line);) {
+    std::size_t commas = 0;
+    bool quoted = false;
+    for (const char c : line) {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) ++commas;
+    }
+    fields.push_back(commas + 1);
+  }
+  ASSERT_GT(fields.size(), 2u);
+  for (std::size_t i = 1; i < fields.size(); ++i)
+    EXPECT_EQ(fields[i], fields[0]) << "row " << i;
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -417,15 +418,21 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
                           const std::filesystem::path& path) {
   std::ofstream file(path);
   if (!file) return Error{ErrorCode::kIo, path.string() + ": cannot open for writing"};
-  file << "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
-          "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
-          "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,"
-          "morph_target_distance,mass_scale,stray_share,point_mass_peak,predicted_error,status\n";
+  constexpr std::string_view kHeader =
+      "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
+      "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
+      "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,"
+      "morph_target_distance,mass_scale,stray_share,point_mass_peak,predicted_error,status";
+  // A shape that failed has its five shape columns, every method column empty, and its status.
+  constexpr std::size_t kShapeColumns = 5;
+  const std::string noMethod(
+      static_cast<std::size_t>(std::count(kHeader.begin(), kHeader.end(), ',')) - kShapeColumns, ',');
+  file << kHeader << "\n";
   for (const FragmentEvaluation& e : evaluations) {
     const std::string head = csvField(e.name) + "," + std::to_string(e.triangles) + "," + number(e.volume) +
                              "," + std::to_string(e.truthTets) + "," + number(e.truthSeconds) + ",";
     if (e.methods.empty()) {
-      file << head << std::string(26, ',') << csvField(e.error) << "\n";
+      file << head << noMethod << csvField(e.error) << "\n";
       continue;
     }
     for (const MethodEvaluation& m : e.methods) {
