@@ -8,6 +8,7 @@
 #include <shapedb/core/self_intersection.h>
 
 #include "family_shapes.h"
+#include "random_draws.h"
 
 namespace shapedb::volume::detail {
 namespace {
@@ -119,13 +120,12 @@ Result<TriangleMesh> makeUnionShape(int count, std::mt19937_64& rng, std::size_t
         Vec3 centre = Vec3::Zero(), half = Vec3::Ones();  // the last primitive's centre and half-extents
         for (int i = 0; i < count; ++i) {
           const double scale = i == 0 ? 1.0 : 0.4 + 0.6 * unit(rng);
-          const Vec3 size = scale * Vec3(1.0, logUniform(rng, 0.3, 1.0), logUniform(rng, 0.3, 1.0));
+          const double depth = logUniform(rng, 0.3, 1.0);  // drawn first, as GCC did (random_draws.h)
+          const Vec3 size = scale * Vec3(1.0, logUniform(rng, 0.3, 1.0), depth);
           if (i > 0) {
-            const Vec3 inside(2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0);
+            const Vec3 inside = detail::drawVector([&] { return 2.0 * unit(rng) - 1.0; });
             centre += rotation * (0.5 * inside.cwiseProduct(half));
-            rotation = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-                           .normalized()
-                           .toRotationMatrix();
+            rotation = detail::drawQuaternion([&] { return normal(rng); }).normalized().toRotationMatrix();
           }
           TriangleMesh primitive;
           switch (static_cast<int>(4.0 * unit(rng))) {

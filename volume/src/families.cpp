@@ -16,6 +16,7 @@
 
 #include "family_shapes.h"
 #include "polyhedron.h"
+#include "random_draws.h"
 
 namespace shapedb::volume {
 namespace {
@@ -89,11 +90,11 @@ TriangleMesh makeShard(std::uint64_t seed) {
     }
     const int cuts = 6 + static_cast<int>(unit(rng) * 9.0);
     for (int c = 0; c < cuts; ++c) {
-      Vec3 n(normal(rng), normal(rng), normal(rng));
-      n.normalize();
+      const Vec3 n = detail::drawVector([&] { return normal(rng); }).normalized();
       faces = clip(faces, n, 0.35 + 0.65 * unit(rng));
     }
-    const Vec3 stretch(1.0, std::exp(std::log(0.2) * unit(rng)), std::exp(std::log(kMinRatio) * unit(rng)));
+    const double thinnest = std::exp(std::log(kMinRatio) * unit(rng));  // drawn first, as GCC did
+    const Vec3 stretch(1.0, std::exp(std::log(0.2) * unit(rng)), thinnest);
     TriangleMesh mesh = scaled(triangulate(faces), stretch);
     if (core::validateMesh(mesh).ok() && core::analyzeTopology(mesh).isClosed()) return mesh;
   }
@@ -155,8 +156,7 @@ TriangleMesh makeFragment(const ShapeSpec& spec) {
   for (;;) {
     std::vector<Vec3> seeds;
     while (static_cast<int>(seeds.size()) < pieces) {
-      const Vec3 p =
-          Vec3(2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0).cwiseProduct(half);
+      const Vec3 p = detail::drawVector([&] { return 2.0 * unit(rng) - 1.0; }).cwiseProduct(half);
       if (insideFragmentSolid(kind, half, p)) seeds.push_back(p);
     }
     const std::vector<Polygon> cell = detail::voronoiCell(solid, seeds, 0);

@@ -18,6 +18,7 @@
 
 #include "level_set.h"
 #include "polyhedron.h"
+#include "random_draws.h"
 
 namespace shapedb::volume {
 
@@ -130,7 +131,8 @@ Result<FractureResult> fracture(const TriangleMesh& mesh, const FractureOptions&
   const openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> inside(*solid);
   const long attempts = 1000L * options.pieces + 100000L;
   for (long a = 0; a < attempts && static_cast<int>(seeds.size()) < options.pieces; ++a) {
-    const Vec3 p = bounds.min + (bounds.max - bounds.min).cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng)));
+    const Vec3 p =
+        bounds.min + (bounds.max - bounds.min).cwiseProduct(detail::drawVector([&] { return unit(rng); }));
     if (inside.wsSample(openvdb::Vec3R(p.x(), p.y(), p.z())) < 0.0) seeds.push_back(p);
   }
   if (seeds.empty())

@@ -7,6 +7,7 @@
 #include <shapedb/core/primitives.h>
 
 #include "family_shapes.h"
+#include "random_draws.h"
 
 namespace shapedb::volume::detail {
 namespace {
@@ -414,7 +415,7 @@ TriangleMesh makeStoneShape(double a, double b, double amplitude, int subdivisio
   std::array<double, kWaves> weights{}, frequencies{}, phases{};
   double total = 0.0;
   for (int k = 0; k < kWaves; ++k) {
-    directions[k] = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+    directions[k] = detail::drawVector([&] { return normal(rng); }).normalized();
     frequencies[k] = 1.0 + 2.5 * unit(rng);
     phases[k] = kTwoPi * unit(rng);
     weights[k] = 0.2 + unit(rng);
