@@ -124,7 +124,8 @@ Result<TriangleMesh> makeUnionShape(int count, std::mt19937_64& rng, std::size_t
           const Vec3 size = scale * Vec3(1.0, logUniform(rng, 0.3, 1.0), depth);
           if (i > 0) {
             const Vec3 inside = detail::drawVector([&] { return 2.0 * unit(rng) - 1.0; });
-            centre += rotation * (0.5 * inside.cwiseProduct(half));
+            const Vec3 step = 0.5 * inside.cwiseProduct(half);  // rotated written out, as transformPoint
+            centre += rotation.col(0) * step.x() + rotation.col(1) * step.y() + rotation.col(2) * step.z();
             rotation = detail::drawQuaternion([&] { return normal(rng); }).normalized().toRotationMatrix();
           }
           TriangleMesh primitive;
