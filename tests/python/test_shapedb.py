@@ -40,9 +40,13 @@ def test_mass_properties_equal_the_tools_bit_for_bit(cli, samples, name):
     assert not mine["is_approximate"]
 
     # The tool normalizes at the material's density, the module at unit density: the same moments to the
-    # last bits.
+    # last bits of the largest (an eigensolver's round-off is relative to the matrix's norm, so a rod's
+    # small moment about its axis may differ by a few units in its own last place).
     frame = shapedb.normalize(vertices, faces)
-    np.testing.assert_allclose(frame["canonical_moments"], tool["canonical_moments"], rtol=1e-14)
+    largest = max(tool["canonical_moments"])
+    np.testing.assert_allclose(
+        frame["canonical_moments"], tool["canonical_moments"], rtol=0, atol=1e-14 * largest
+    )
     # The frame carries the mesh to unit volume about the origin.
     canonical = vertices @ frame["canonical_from_mesh"][:3, :3].T + frame["canonical_from_mesh"][:3, 3]
     moved = shapedb.mass_properties(canonical, faces)

@@ -119,6 +119,9 @@ TEST(Tetrahedralize, TetsHeldByAnEdgeOrANodeAloneArePiecesOfTheirOwn) {
 // whose dropping left a part held by an edge: its entry rang at 18 Hz, then 11.5 kHz (the finer direct
 // computation's first mode). Fragment 46 lost 282 flat tets between nearly coplanar facets and fell into
 // five pieces: 1 kHz instead of ~17. Now each entry is one piece without a near-zero mode, or refused.
+// Both are near the edge either way: since the canonical move was written out (core::transformPoint), a
+// round-off away from the one before, both are refused. The first fragments are there so that the test
+// always computes some.
 TEST(Tetrahedralize, FragmentsOfAPlateHaveNoMechanism) {
   FractureOptions fracturing;
   fracturing.pieces = 50;
@@ -135,7 +138,7 @@ TEST(Tetrahedralize, FragmentsOfAPlateHaveNoMechanism) {
   EntryOptions options = withElements(EntryOptions{}, ElementOrder::kQuadratic);
   options.modal.modes = 3;
   int computed = 0;
-  for (std::size_t i : {std::size_t{16}, std::size_t{46}}) {
+  for (std::size_t i : {0, 1, 2, 3, 16, 46}) {
     auto entry = computeEntry(broken->fragments[i], options);
     if (!entry) {
       std::printf("fragment %zu refused: %s\n", i, entry.error().message.c_str());
