@@ -296,6 +296,87 @@ TEST(Correction, NoNodeTakesMoreOfTheMissingMassThanItsLimit) {
   EXPECT_GT(morphed->report.pointMassPeak, 2.0 * kPointMassLimit);  // the limit held some node back
 }
 
+// A node the morph leaves held by next to no stiffness (here the tip of a needle tet standing on a box's
+// face) rings on its own once mass is lumped there: a mode of that node, which the object does not have,
+// as the first. The correction finds it (lumpedModeShare past kLumpedModeLimit) and computes the modes
+// again with the missing mass spread over the tets as density: then they are the modes computed directly
+// so. The same mass lumped over the whole face is left lumped. The lump is a fiftieth of the box's mass: a
+// heavier one swings the free box about with it, and its own share of the mode falls (0.42 at a third).
+TEST(Correction, AModeOfOneNodesLumpedMassIsFoundAndTheMassIsSpreadInstead) {
+  core::PhysicalData entry = entryData(core::makeBox(Vec3(1.0, 0.8, 0.6)), 6);
+  TetMesh mesh = entry.tetMesh;
+  const auto onFace = [&](std::uint32_t v) { return std::abs(mesh.nodes[v].x() - 0.5) < 1e-9; };
+  const std::vector<core::BoundaryFace> faces = core::boundaryFaces(mesh);
+  const auto base = std::find_if(faces.begin(), faces.end(), [&](const core::BoundaryFace& f) {
+    return onFace(f.nodes[0]) && onFace(f.nodes[1]) && onFace(f.nodes[2]);
+  });
+  ASSERT_NE(base, faces.end());
+  const auto [a, b, c] = base->nodes;
+  const auto apex = static_cast<std::uint32_t>(mesh.nodeCount());
+  mesh.nodes.push_back((mesh.nodes[a] + mesh.nodes[b] + mesh.nodes[c]) / 3.0 + Vec3(0.6, 0.0, 0.0));
+  mesh.tets.push_back({a, b, c, apex});
+  if (core::tetVolume(mesh, mesh.tetCount() - 1) < 0.0) std::swap(mesh.tets.back()[0], mesh.tets.back()[1]);
+  Result<core::ModalData> seeds = computeModes(mesh, modalOptions(6));
+  ASSERT_TRUE(seeds.ok()) << seeds.error().message;
+  entry.tetMesh = mesh;
+  entry.modes = *seeds;
+  const double volume = core::computeTetMassProperties(mesh).volume, missing = 0.01;
+
+  const auto correctedWith = [&](std::vector<double> pointMasses) {
+    MorphedEntry morphed;
+    morphed.tetMesh = mesh;
+    morphed.pointMasses = std::move(pointMasses);
+    morphed.report.massScale = (volume + missing) / volume;
+    return correctMorphed(entry, std::move(morphed), modalOptions(6));
+  };
+  ModalOptions spread = modalOptions(6);
+  spread.material.density = (volume + missing) / volume;
+  Result<core::ModalData> direct = computeModes(mesh, spread);
+  ASSERT_TRUE(direct.ok()) << direct.error().message;
+
+  // All of it at the needle's tip: that node's own mode comes first, far below the body's.
+  std::vector<double> atTip(mesh.nodeCount(), 0.0);
+  atTip[apex] = missing;
+  ModalOptions lumped = modalOptions(6);
+  lumped.pointMasses = atTip;
+  Result<core::ModalData> tipMode = computeModes(mesh, lumped);
+  ASSERT_TRUE(tipMode.ok()) << tipMode.error().message;
+  EXPECT_LT(tipMode->eigenvalues[0], 0.25 * direct->eigenvalues[0]);
+  Result<CorrectedEntry> tip = correctedWith(atTip);
+  ASSERT_TRUE(tip.ok()) << tip.error().message;
+  std::printf("needle tip: lumped mode share %.3f; first eigenvalue %.4g lumped, %.4g spread\n",
+              tip->report.lumpedModeShare, tipMode->eigenvalues[0], tip->physics.modes.eigenvalues[0]);
+  EXPECT_GT(tip->report.lumpedModeShare, kLumpedModeLimit);
+  EXPECT_TRUE(tip->report.massSpread);
+  for (Eigen::Index m = 0; m < 6; ++m)
+    EXPECT_NEAR(tip->physics.modes.eigenvalues[m], direct->eigenvalues[m], 1e-6 * direct->eigenvalues[m])
+        << "mode " << m;
+
+  // The same mass over the face's nodes by their own masses: the body's modes, with the mass lumped. (By
+  // their number, the box's corner nodes, each a share of few tets, took several times their own mass,
+  // and one of the first modes had 0.56 of its energy on one of them.)
+  std::vector<double> own(mesh.nodeCount(), 0.0), overFace(mesh.nodeCount(), 0.0);
+  for (std::size_t t = 0; t + 1 < mesh.tetCount(); ++t)  // the box's tets, not the needle
+    for (const std::uint32_t n : mesh.tets[t])
+      own[n] += 0.25 * std::abs(core::tetVolume(mesh, t));
+  double faceMass = 0.0;
+  for (std::uint32_t v = 0; v < apex; ++v)
+    faceMass += onFace(v) ? own[v] : 0.0;
+  for (std::uint32_t v = 0; v < apex; ++v)
+    if (onFace(v)) overFace[v] = missing * own[v] / faceMass;
+  lumped.pointMasses = overFace;
+  Result<core::ModalData> faceModes = computeModes(mesh, lumped);
+  ASSERT_TRUE(faceModes.ok()) << faceModes.error().message;
+  Result<CorrectedEntry> spreadOver = correctedWith(overFace);
+  ASSERT_TRUE(spreadOver.ok()) << spreadOver.error().message;
+  EXPECT_LT(spreadOver->report.lumpedModeShare, kLumpedModeLimit);
+  EXPECT_FALSE(spreadOver->report.massSpread);
+  for (Eigen::Index m = 0; m < 6; ++m)
+    EXPECT_NEAR(spreadOver->physics.modes.eigenvalues[m], faceModes->eigenvalues[m],
+                1e-6 * faceModes->eigenvalues[m])
+        << "mode " << m;
+}
+
 // The shares of the missing mass against a search for the same answer by bisection: λ such that
 // Σ min(λ wᵢ, L mᵢ) is the mass to place (L = kPointMassLimit), each node's share min(λ wᵢ, L mᵢ); or,
 // where even every weighted node at its limit is too little, those limits and the rest by own mass.

@@ -202,6 +202,23 @@ ModalOptions morphedModalOptions(const MorphedEntry& morphed, const ModalOptions
   return unit;
 }
 
+namespace {
+
+// CorrectionReport::lumpedModeShare of `modes`, computed with `pointMasses`.
+double lumpedModeShare(const core::ModalData& modes, std::span<const double> pointMasses) {
+  // The shapes are M-orthonormal, lumped masses included: node i's share of the first mode's kinetic
+  // energy is its lumped mass times |φᵢ|² (its share of the tets' own mass is left out).
+  double most = 0.0;
+  if (modes.shapes.cols() > 0)
+    for (std::size_t i = 0; i < pointMasses.size(); ++i)
+      most =
+          std::max(most, pointMasses[i] *
+                             modes.shapes.col(0).segment<3>(3 * static_cast<Eigen::Index>(i)).squaredNorm());
+  return most;
+}
+
+}  // namespace
+
 Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEntry morphed,
                                       const ModalOptions& modal) {
   CorrectedEntry out;
@@ -211,9 +228,21 @@ Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEn
 
   // The entry's modes on the same nodes are the seeds: the morph moved the nodes, not their numbering.
   const Clock::time_point start = Clock::now();
-  const ModalOptions unit = morphedModalOptions(morphed, modal);
+  ModalOptions unit = morphedModalOptions(morphed, modal);
   auto modes = computeModesFrom(out.physics.tetMesh, entry.modes.shapes, unit, &out.report.solves);
   if (!modes) return withContext(modes.error(), "correction: modes on the morphed tets");
+  out.report.lumpedModeShare = lumpedModeShare(*modes, unit.pointMasses);
+  if (out.report.lumpedModeShare > kLumpedModeLimit) {
+    // A mode of one node's lumped mass, which the object does not have: the missing mass over the tets
+    // instead, as density.
+    unit.pointMasses.clear();
+    unit.material.density = out.report.massScale;
+    int solves = 0;
+    modes = computeModesFrom(out.physics.tetMesh, entry.modes.shapes, unit, &solves);
+    if (!modes) return withContext(modes.error(), "correction: modes on the morphed tets, the mass spread");
+    out.report.solves += solves;
+    out.report.massSpread = true;
+  }
   out.physics.modes = std::move(modes).value();
   out.report.modesSeconds = secondsSince(start);
 
