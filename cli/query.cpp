@@ -118,6 +118,8 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mass_scale", c.massScale},
           {"stray_share", c.strayShare},
           {"point_mass_peak", c.pointMassPeak},
+          {"lumped_mode_share", c.lumpedModeShare},
+          {"mass_spread", c.massSpread},
           {"morphs", c.morphs},
           {"fallback", c.fallback},
           {"solves", c.solves},

@@ -175,8 +175,9 @@ py::dict correctionDict(const volume::CorrectionReport& r) {
       "worst_quality"_a = m.worstQuality, "max_boundary_move"_a = m.maxBoundaryMove,
       "mean_boundary_move"_a = m.meanBoundaryMove, "mean_target_distance"_a = m.meanTargetDistance,
       "projected"_a = m.projected, "mass_scale"_a = r.massScale, "stray_share"_a = r.strayShare,
-      "point_mass_peak"_a = r.pointMassPeak, "solves"_a = r.solves, "morphs"_a = r.morphs,
-      "fallback"_a = r.fallback, "morph_seconds"_a = r.morphSeconds, "modes_seconds"_a = r.modesSeconds);
+      "point_mass_peak"_a = r.pointMassPeak, "lumped_mode_share"_a = r.lumpedModeShare,
+      "mass_spread"_a = r.massSpread, "solves"_a = r.solves, "morphs"_a = r.morphs, "fallback"_a = r.fallback,
+      "morph_seconds"_a = r.morphSeconds, "modes_seconds"_a = r.modesSeconds);
 }
 
 py::dict timesDict(const io::QueryTimes& t) {

@@ -17,6 +17,7 @@
 #include <shapedb/core/adapt.h>
 #include <shapedb/core/primitives.h>
 #include <shapedb/io/mesh_io.h>
+#include <shapedb/volume/correction.h>
 #include <shapedb/volume/entry.h>
 
 #include "cli_test_support.h"
@@ -114,6 +115,9 @@ TEST(QueryCli, JsonParsedBackWithMatchesPhysicsFidelityAndFiles) {
   ASSERT_TRUE(cj.contains("correction")) << corrected.out;
   EXPECT_GT(cj["correction"]["worst_quality"].get<double>(), 0.0);
   EXPECT_GT(cj["correction"]["max_boundary_move"].get<double>(), 0.0);
+  // A box onto a box lumps little or nothing, and no mode is one node's.
+  EXPECT_LT(cj["correction"]["lumped_mode_share"].get<double>(), volume::kLumpedModeLimit);
+  EXPECT_FALSE(cj["correction"]["mass_spread"].get<bool>());
   EXPECT_TRUE(cj["physics"]["warnings"].empty()) << cj["physics"]["warnings"];
   EXPECT_EQ(cj["physics"]["mass"], p["mass"]);
   // The correction computes the modes for aluminium's own Poisson ratio: so does the direct computation.

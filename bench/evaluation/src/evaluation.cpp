@@ -318,6 +318,7 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
               m.massScale = q.correction->massScale;
               m.strayShare = q.correction->strayShare;
               m.pointMassPeak = q.correction->pointMassPeak;
+              m.lumpedModeShare = q.correction->lumpedModeShare;
             }
             if (q.predictedFrequencyError) m.predictedError = *q.predictedFrequencyError;
             m.matchMicros = q.times.validate + q.times.massProperties + q.times.describe + q.times.search;
@@ -422,7 +423,7 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
       "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
       "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
       "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,"
-      "morph_target_distance,mass_scale,stray_share,point_mass_peak,predicted_error,status";
+      "morph_target_distance,mass_scale,stray_share,point_mass_peak,lumped_mode_share,predicted_error,status";
   // A shape that failed has its five shape columns, every method column empty, and its status.
   constexpr std::size_t kShapeColumns = 5;
   const std::string noMethod(
@@ -449,8 +450,8 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
            << number(m.meanDeviation) << "," << number(m.maxDeviation) << "," << number(m.maxMomentError)
            << "," << number(m.descriptorDistance) << "," << number(m.outsideShare) << ","
            << number(m.morphTargetDistance) << "," << number(m.massScale) << "," << number(m.strayShare)
-           << "," << number(m.pointMassPeak) << "," << number(m.predictedError) << ","
-           << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
+           << "," << number(m.pointMassPeak) << "," << number(m.lumpedModeShare) << ","
+           << number(m.predictedError) << "," << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
     }
   }
   file.flush();

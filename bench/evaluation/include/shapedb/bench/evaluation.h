@@ -77,10 +77,11 @@ struct MethodEvaluation {
   /// The corrected query: how far the shape's surface stays from the morphed tets, on average (relative
   /// to L; volume::MorphReport::meanTargetDistance).
   double morphTargetDistance = kNaN;
-  double massScale = kNaN;       ///< the corrected query: volume::CorrectionReport::massScale
-  double strayShare = kNaN;      ///< the corrected query: volume::CorrectionReport::strayShare
-  double pointMassPeak = kNaN;   ///< the corrected query: volume::CorrectionReport::pointMassPeak
-  double predictedError = kNaN;  ///< descriptors: the query's QueryResult::predictedFrequencyError
+  double massScale = kNaN;        ///< the corrected query: volume::CorrectionReport::massScale
+  double strayShare = kNaN;       ///< the corrected query: volume::CorrectionReport::strayShare
+  double pointMassPeak = kNaN;    ///< the corrected query: volume::CorrectionReport::pointMassPeak
+  double lumpedModeShare = kNaN;  ///< the corrected query: volume::CorrectionReport::lumpedModeShare
+  double predictedError = kNaN;   ///< descriptors: the query's QueryResult::predictedFrequencyError
   double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link), fidelity
                               ///< report aside
   double matchMicros = kNaN;  ///< descriptors: validate, mass properties, describe, search
