@@ -76,10 +76,10 @@ std::vector<double> limitedShares(std::span<const double> weights, std::span<con
 namespace {
 
 // `mass` shared among the nodes of `tets` next to where `target` lies outside them (MorphedEntry::
-// pointMasses), none more than kPointMassLimit times its own; empty if no sample of the target lies
-// outside. `peak`: CorrectionReport::pointMassPeak.
-std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::View& target, double mass,
-                                double& peak) {
+// pointMasses), none more than kPointMassLimit times its `own` mass (nodeMasses); empty if no sample of
+// the target lies outside. `peak`: CorrectionReport::pointMassPeak.
+std::vector<double> missingMass(const core::TetMesh& tets, std::span<const double> own,
+                                const MorphTarget::View& target, double mass, double& peak) {
   const std::vector<double>& area = target.target().sampleAreas();
   const core::TetLocator locator(tets);
   core::TetLocator::Hint hint;
@@ -95,7 +95,6 @@ std::vector<double> missingMass(const core::TetMesh& tets, const MorphTarget::Vi
   }
   const double total = std::accumulate(share.begin(), share.end(), 0.0);
   if (!(total > 0.0)) return {};
-  const std::vector<double> own = nodeMasses(tets);
   peak = 0.0;
   for (std::size_t i = 0; i < share.size(); ++i)
     if (share[i] > 0.0 && own[i] > 0.0) peak = std::max(peak, mass * share[i] / total / own[i]);
@@ -164,10 +163,12 @@ Result<MorphedEntry> morphEntry(const core::PhysicalData& entry, const MorphTarg
 void placeMissingMass(MorphedEntry& morphed, const MorphTarget::View& target) {
   const std::optional<core::MassProperties>& targetMass = target.target().massProperties();
   if (!targetMass) return;
-  const double volume = core::computeTetMassProperties(morphed.tetMesh).volume;
+  // The tets' volume is their nodes' own masses at unit density, which the sharing needs too.
+  const std::vector<double> own = nodeMasses(morphed.tetMesh);
+  const double volume = std::accumulate(own.begin(), own.end(), 0.0);
   if (std::isfinite(targetMass->volume / volume) && targetMass->volume > volume && volume > 0.0)
     morphed.pointMasses =
-        missingMass(morphed.tetMesh, target, targetMass->volume - volume, morphed.report.pointMassPeak);
+        missingMass(morphed.tetMesh, own, target, targetMass->volume - volume, morphed.report.pointMassPeak);
 }
 
 std::vector<std::string> correctionWarnings(const CorrectionReport& report) {
@@ -234,9 +235,9 @@ Result<CorrectedEntry> correctMorphed(const core::PhysicalData& entry, MorphedEn
   out.report.lumpedModeShare = lumpedModeShare(*modes, unit.pointMasses);
   if (out.report.lumpedModeShare > kLumpedModeLimit) {
     // A mode of one node's lumped mass, which the object does not have: the missing mass over the tets
-    // instead, as density.
-    unit.pointMasses.clear();
-    unit.material.density = out.report.massScale;
+    // instead, as density (what morphedModalOptions gives where none is lumped).
+    morphed.pointMasses.clear();
+    unit = morphedModalOptions(morphed, modal);
     int solves = 0;
     modes = computeModesFrom(out.physics.tetMesh, entry.modes.shapes, unit, &solves);
     if (!modes) return withContext(modes.error(), "correction: modes on the morphed tets, the mass spread");
