@@ -22,6 +22,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <shapedb/core/statistics.h>
@@ -227,6 +228,15 @@ int main(int argc, char** argv) {
       "(tick us p99 %.2f, max %.1f)\n",
       sweepSeconds, base.deadlineMisses, without.deadlineMisses, with.deadlineMisses, with.tickMicros.p99,
       with.tickMicros.max);
+  // Why a tick misses: it ran long, it started late (the loop thread waited for a core, or for the memory
+  // map in a page fault), or both.
+  for (const auto& [name, r] :
+       {std::pair{"empty loop", &base}, {"without learning", &without}, {"with learning", &with}})
+    std::printf(
+        "  %s: tick start late us p50 %.1f, p99 %.1f, max %.0f; loop thread page faults %zu; "
+        "real-time priority %s\n",
+        name, r->startLateMicros.p50, r->startLateMicros.p99, r->startLateMicros.max, r->pageFaults,
+        r->realtimePriority ? "yes" : "no");
   fs::remove(work);
   return 0;
 }
