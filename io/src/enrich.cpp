@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <deque>
 #include <exception>
+#include <latch>
 #include <mutex>
 #include <thread>
 #include <unordered_map>
@@ -14,6 +15,7 @@
 #include <shapedb/core/mass_properties.h>
 #include <shapedb/io/enrich.h>
 #include <shapedb/volume/simplify.h>
+#include <shapedb/volume/tetrahedralize.h>
 
 namespace shapedb::io {
 namespace {
@@ -136,8 +138,20 @@ void Enricher::Impl::run(Job& job) {
 
 Enricher::Enricher(Database& database, const EnricherOptions& options)
     : mImpl(std::make_unique<Impl>(database, options)) {
-  for (int i = 0; i < std::max(1, options.workers); ++i)
-    mImpl->workers.emplace_back([impl = mImpl.get()] { impl->work(); });
+  // Each worker forks its TetGen process before the constructor returns, not at its first object: a fork
+  // stalls the page faults of every other thread of the process, and turns the pages they write next
+  // copy-on-write (volume::startTetGenWorker). A haptic loop started after the Enricher then sees no fork
+  // while it runs (docs/architecture.md, "No fork while it runs").
+  const int count = std::max(1, options.workers);
+  std::latch started(count);
+  for (int i = 0; i < count; ++i)
+    mImpl->workers.emplace_back([impl = mImpl.get(), &started] {
+      // A worker that cannot start one now tries again at its first object, and reports it there.
+      static_cast<void>(volume::startTetGenWorker());
+      started.count_down();
+      impl->work();
+    });
+  started.wait();
 }
 
 Enricher::~Enricher() {

@@ -17,6 +17,7 @@
 #include <shapedb/io/database.h>
 #include <shapedb/io/enrich.h>
 #include <shapedb/volume/entry.h>
+#include <shapedb/volume/tetrahedralize.h>
 
 #include "support/synthetic.h"
 #include "support/test_support.h"
@@ -137,6 +138,23 @@ TEST(Enrich, AnObjectIsComputedOnceWhetherQueuedLearnedOrLearnedByAnEarlierRun) 
   EXPECT_FALSE(known->computed);
   EXPECT_EQ(known->id, id);
   EXPECT_EQ(db->size(), 5u);
+}
+
+// The Enricher's workers fork their TetGen processes before its constructor returns (a fork stalls the
+// page faults of every thread of the process: a haptic loop started after the Enricher sees none), and
+// learning an object forks nothing more.
+TEST(Enrich, TheWorkersForkTheirTetGenProcessesBeforeTheEnricherIsReady) {
+  test::ScratchDir dir("enrich-forks");
+  const auto path = tinyDatabase(dir);
+  auto db = Database::open(path, learning());
+  ASSERT_TRUE(db.ok()) << db.error().message;
+  const int before = volume::testing::tetGenWorkersStarted();
+  Enricher enricher(*db, {.workers = 2});
+  EXPECT_EQ(volume::testing::tetGenWorkersStarted(), before + 2);
+  auto learned = learnedOf(enricher.submit(blob(1.0, 0.7, 0.5, "pebble")));
+  ASSERT_TRUE(learned.ok()) << learned.error().message;
+  EXPECT_TRUE(learned->computed);
+  EXPECT_EQ(volume::testing::tetGenWorkersStarted(), before + 2);
 }
 
 TEST(Enrich, ABadObjectFailsByNameAndIsNotComputedAgain) {

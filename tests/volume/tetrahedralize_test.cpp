@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -221,6 +222,31 @@ TEST(Tetrahedralize, AWorkerThatDiesDoesNotChangeTheMesh) {
     for (std::size_t i = 0; i < healthy.nodes.size(); ++i)
       ASSERT_EQ(afterDeath.nodes[i], healthy.nodes[i]) << "box " << spec.index;
   }
+}
+
+// startTetGenWorker forks the calling thread's worker now, once: a second call and the thread's meshes
+// use it, and another thread's first mesh forks its own. Without it the first mesh forks.
+TEST(Tetrahedralize, AWorkerStartedAheadIsTheOneTheThreadMeshesWith) {
+  const core::TriangleMesh box = core::makeBox(Vec3(1.0, 0.8, 0.6));
+  std::thread([&] {
+    const int before = testing::tetGenWorkersStarted();
+    ASSERT_TRUE(startTetGenWorker().ok());
+    EXPECT_EQ(testing::tetGenWorkersStarted(), before + 1);
+    ASSERT_TRUE(startTetGenWorker().ok());
+    meshOrDie(box);
+    meshOrDie(box);
+    EXPECT_EQ(testing::tetGenWorkersStarted(), before + 1) << "the started worker meshes";
+  }).join();
+  std::thread([&] {
+    const int before = testing::tetGenWorkersStarted();
+    meshOrDie(box);
+    EXPECT_EQ(testing::tetGenWorkersStarted(), before + 1) << "a thread's first mesh forks its worker";
+    // A worker that died is forked again, started ahead or at the next mesh.
+    testing::killNextTetGenWorkers(1);
+    meshOrDie(box);
+    testing::killNextTetGenWorkers(0);
+    EXPECT_EQ(testing::tetGenWorkersStarted(), before + 2);
+  }).join();
 }
 
 // A wall about as thick as the volume bound's tets gets about one quadratic tet across, and bends too

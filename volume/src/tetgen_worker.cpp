@@ -111,6 +111,8 @@ using core::sendAll;
 
 // testing::killNextTetGenWorkers: how many requests are still to find their worker killed.
 std::atomic<int> gWorkersToKill{0};
+// testing::tetGenWorkersStarted: the workers this process has forked.
+std::atomic<int> gWorkersStarted{0};
 
 bool takeInjectedKill() {
   int left = gWorkersToKill.load();
@@ -160,11 +162,13 @@ class TetGenWorker {
  public:
   ~TetGenWorker() { stop(); }
 
+  /// Forks the worker unless it is running.
+  Status ensureStarted() { return mPid > 0 ? Status(Ok{}) : start(); }
+
   Result<TetGenOutput> run(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
                            const std::vector<core::Vec3>& holes, const std::string& switches,
                            double timeout) {
-    if (mPid <= 0)
-      if (Status st = start(); !st) return st.error();
+    if (Status st = ensureStarted(); !st) return st.error();
     if (takeInjectedKill()) ::kill(mPid, SIGKILL);
     const Deadline deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -221,6 +225,7 @@ class TetGenWorker {
     ::close(fds[1]);
     mFd = fds[0];
     mPid = pid;
+    gWorkersStarted.fetch_add(1);
     return Ok{};
   }
 
@@ -242,13 +247,18 @@ class TetGenWorker {
   int mFd = -1;
 };
 
+/// This thread's worker.
+TetGenWorker& threadWorker() {
+  thread_local TetGenWorker worker;
+  return worker;
+}
+
 }  // namespace
 
 Result<TetGenOutput> runTetGenGuarded(const TriangleMesh& surface, const std::vector<double>& maxVolumes,
                                       const std::vector<core::Vec3>& holes, const std::string& switches,
                                       double timeout) {
-  thread_local TetGenWorker worker;
-  return worker.run(surface, maxVolumes, holes, switches, timeout);
+  return threadWorker().run(surface, maxVolumes, holes, switches, timeout);
 }
 
 /// TetGen's error codes (terminatetetgen in tetgen.cxx).
@@ -273,9 +283,16 @@ std::string describeTetGenError(int code) {
 
 }  // namespace detail
 
+Status startTetGenWorker() {
+  return detail::threadWorker().ensureStarted();
+}
+
 namespace testing {
 void killNextTetGenWorkers(int count) {
   detail::gWorkersToKill.store(std::max(count, 0));
+}
+int tetGenWorkersStarted() {
+  return detail::gWorkersStarted.load();
 }
 }  // namespace testing
 

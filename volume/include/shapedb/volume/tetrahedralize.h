@@ -69,11 +69,22 @@ Result<core::TetMesh> tetrahedralize(const core::TriangleMesh& surface,
 /// the bound.
 void dropFlatTets(core::TetMesh& mesh);
 
+/// Starts the calling thread's TetGen process now, if it has none running: tetrahedralize runs TetGen in
+/// one per thread, forked at the thread's first call (and again after a crash or a timeout). A fork
+/// holds up every page fault of the process's other threads while it copies the memory map, and leaves
+/// their pages copy-on-write, so that each page they write next faults once more. A thread that will
+/// mesh while a real-time thread runs (the haptic loop's enrichment: io::Enricher) starts its worker
+/// first, before the loop does. Errors: kIo (no process could be started; tetrahedralize then tries
+/// again). Thread-safe (each thread its own).
+Status startTetGenWorker();
+
 namespace testing {
 /// Fault injection, for tests: the guarded worker of each of the next `count` TetGen requests (in any
 /// thread of this process) is killed before it gets the request, as a crash or a hang of the worker
 /// itself would leave it.
 void killNextTetGenWorkers(int count);
+/// The TetGen workers this process has forked so far (any thread).
+int tetGenWorkersStarted();
 }  // namespace testing
 
 }  // namespace shapedb::volume
