@@ -241,7 +241,7 @@ TEST(Tetrahedralize, AWorkerStartedAheadIsTheOneTheThreadMeshesWith) {
     const int before = testing::tetGenWorkersStarted();
     meshOrDie(box);
     EXPECT_EQ(testing::tetGenWorkersStarted(), before + 1) << "a thread's first mesh forks its worker";
-    // A worker that died is forked again, started ahead or at the next mesh.
+    // A worker that dies is forked again within the same call, which repeats its request in a fresh one.
     testing::killNextTetGenWorkers(1);
     meshOrDie(box);
     testing::killNextTetGenWorkers(0);
