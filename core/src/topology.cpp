@@ -18,12 +18,20 @@ bool hasRepeatedVertex(const TriangleMesh::Triangle& t) {
 }
 
 // Zero area relative to the triangle's own size: twice the area below 1e-12 of its longest edge squared.
-bool hasZeroArea(const TriangleMesh& mesh, const TriangleMesh::Triangle& t) {
+/// Whether the corner of `t` across its longest edge lies within relativeHeight × that edge's length of
+/// its line (twice the area is the longest edge times that height).
+bool isThin(const TriangleMesh& mesh, const TriangleMesh::Triangle& t, double relativeHeight) {
   const Vec3& a = mesh.vertices[t[0]];
   const Vec3& b = mesh.vertices[t[1]];
   const Vec3& c = mesh.vertices[t[2]];
   const double longestSq = std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
-  return (b - a).cross(c - a).norm() <= 1e-12 * longestSq;
+  return (b - a).cross(c - a).norm() <= relativeHeight * longestSq;
+}
+
+constexpr double kZeroAreaHeight = 1e-12;
+
+bool hasZeroArea(const TriangleMesh& mesh, const TriangleMesh::Triangle& t) {
+  return isThin(mesh, t, kZeroAreaHeight);
 }
 
 std::string plural(std::size_t n, const std::string& noun, const std::string& nouns = "") {
@@ -163,9 +171,14 @@ Status requireClosedOriented(const TopologyReport& topology) {
 }
 
 std::size_t flipZeroAreaFaces(TriangleMesh& mesh) {
+  return flipThinFaces(mesh, kZeroAreaHeight);
+}
+
+std::size_t flipThinFaces(TriangleMesh& mesh, double relativeHeight) {
+  const auto thin = [&](const TriangleMesh::Triangle& t) { return isThin(mesh, t, relativeHeight); };
   const auto key = [](std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; };
   std::size_t flipped = 0;
-  // A pass flips each zero-area face it can, touching each triangle once; the next pass sees the edges
+  // A pass flips each thin face it can, touching each triangle once; the next pass sees the edges
   // the last one made (a second filler on the same edge flips against the first one's result).
   for (bool progress = true; progress;) {
     progress = false;
@@ -176,8 +189,7 @@ std::size_t flipZeroAreaFaces(TriangleMesh& mesh) {
         triangleOf.emplace(key(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]), t);
     std::vector<char> touched(mesh.triangles.size(), 0);
     for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-      if (touched[t] || hasRepeatedVertex(mesh.triangles[t]) || !hasZeroArea(mesh, mesh.triangles[t]))
-        continue;
+      if (touched[t] || hasRepeatedVertex(mesh.triangles[t]) || !thin(mesh.triangles[t])) continue;
       // The middle corner is the one across the longest edge: the face is (a, b, m), wound a → b → m.
       const TriangleMesh::Triangle& f = mesh.triangles[t];
       int middle = 0;
@@ -198,7 +210,7 @@ std::size_t flipZeroAreaFaces(TriangleMesh& mesh) {
       const std::uint32_t x = g[0] != a && g[0] != b ? g[0] : g[1] != a && g[1] != b ? g[1] : g[2];
       if (x == m || triangleOf.contains(key(m, x)) || triangleOf.contains(key(x, m))) continue;
       const TriangleMesh::Triangle first{m, a, x}, second{x, b, m};
-      if (hasZeroArea(mesh, first) || hasZeroArea(mesh, second)) continue;
+      if (thin(first) || thin(second)) continue;
       mesh.triangles[t] = first;
       mesh.triangles[u] = second;
       // The map follows, so that a later flip of this pass sees the edge m–x made here.

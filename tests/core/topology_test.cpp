@@ -231,6 +231,78 @@ TEST(Topology, ZeroAreaFacesOfTJunctionsAreFlippedAwayLeavingTheSameSurface) {
   }
 }
 
+// Caps, as CAD tessellations leave them: the T-junctions above with the vertex m lifted a hair off the edge
+// ab, into the triangle it splits (so that amx and mbx stay wound as abx was), which makes abm a sliver of
+// height h = lift·|ab| instead of a flat face. Flipped away at a relative height over the lifts: none is
+// left, the surface is closed and wound as before, its vertices are untouched, and its volume moves by at
+// most Σ h·area(the face across ab)/3 (the tets a, b, m, x each flip adds or removes: the oracle bound).
+// At a relative height under the lifts nothing is flipped, and flipZeroAreaFaces flips none.
+TEST(Topology, CapsAreFlippedAwayMovingTheSurfaceByNoMoreThanTheirHeights) {
+  std::mt19937_64 rng(47);
+  const auto volumeOf = [](const TriangleMesh& mesh) {
+    double v = 0.0;
+    for (const auto& t : mesh.triangles)
+      v += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
+    return v;
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    const TriangleMesh original = trial % 2 == 0 ? makeIcosphere(1.0, 2) : makeBox(Vec3(2.0, 1.0, 0.5));
+    TriangleMesh mesh = original;
+    std::vector<char> used(original.triangles.size(), 0);
+    int made = 0;
+    double bound = 0.0;
+    for (int tries = 0; made < 4 && tries < 100; ++tries) {
+      const auto t = static_cast<std::uint32_t>(rng() % original.triangles.size());
+      if (used[t]) continue;
+      const int k = static_cast<int>(rng() % 3);
+      const std::uint32_t a = original.triangles[t][k], b = original.triangles[t][(k + 1) % 3],
+                          x = original.triangles[t][(k + 2) % 3];
+      std::size_t across = 0;  // the face with the edge b → a
+      for (; across < original.triangles.size(); ++across) {
+        const auto& f = original.triangles[across];
+        if ((f[0] == b && f[1] == a) || (f[1] == b && f[2] == a) || (f[2] == b && f[0] == a)) break;
+      }
+      ASSERT_LT(across, original.triangles.size());
+      if (used[across]) continue;
+      used[t] = used[across] = 1;
+      const Vec3 &pa = original.vertices[a], &pb = original.vertices[b], &px = original.vertices[x];
+      const double where = std::uniform_real_distribution<double>(0.2, 0.8)(rng);
+      const double lift = std::pow(10.0, std::uniform_real_distribution<double>(-7.0, -5.0)(rng));
+      const Vec3 onEdge = (1.0 - where) * pa + where * pb;
+      const Vec3 ab = pb - pa;
+      const Vec3 inward = ((px - pa) - (px - pa).dot(ab) / ab.squaredNorm() * ab).normalized();
+      const auto m = static_cast<std::uint32_t>(mesh.vertices.size());
+      mesh.vertices.push_back(onEdge + lift * ab.norm() * inward);
+      mesh.triangles[t] = {a, m, x};
+      mesh.triangles.push_back({m, b, x});
+      mesh.triangles.push_back({a, b, m});  // the cap
+      const auto& f = original.triangles[across];
+      const double acrossArea = 0.5 * (original.vertices[f[1]] - original.vertices[f[0]])
+                                          .cross(original.vertices[f[2]] - original.vertices[f[0]])
+                                          .norm();
+      bound += lift * ab.norm() * acrossArea / 3.0;
+      ++made;
+    }
+    ASSERT_GT(made, 0);
+    const TopologyReport before = analyzeTopology(mesh);
+    ASSERT_TRUE(before.isClosed() && before.isConsistentlyOriented());
+    ASSERT_EQ(findDefects(mesh).zeroAreaFaces, 0u);
+    TriangleMesh unchanged = mesh;
+    EXPECT_EQ(flipZeroAreaFaces(unchanged), 0u);
+    EXPECT_EQ(flipThinFaces(unchanged, 1e-8), 0u);
+    const std::vector<Vec3> vertices = mesh.vertices;
+    const double volume = volumeOf(mesh);
+    EXPECT_EQ(flipThinFaces(mesh, 1e-4), static_cast<std::size_t>(made)) << "trial " << trial;
+    EXPECT_EQ(flipThinFaces(mesh, 1e-4), 0u) << "trial " << trial;  // none is left
+    const TopologyReport after = analyzeTopology(mesh);
+    EXPECT_TRUE(after.isClosed() && after.isConsistentlyOriented()) << "trial " << trial;
+    EXPECT_EQ(after.eulerCharacteristic(), before.eulerCharacteristic());
+    EXPECT_EQ(mesh.vertices, vertices);
+    EXPECT_LE(std::abs(volumeOf(mesh) - volume), bound * (1.0 + 1e-9) + 1e-15) << "trial " << trial;
+    EXPECT_GT(std::abs(volumeOf(mesh) - volume), 0.0) << "trial " << trial;  // the surface did move
+  }
+}
+
 TEST(Validate, AcceptsAGoodMesh) {
   EXPECT_TRUE(validateMesh(makeIcosphere(1.0, 2)).ok());
 }

@@ -112,6 +112,15 @@ Status validateMesh(const TriangleMesh& mesh, const ValidationOptions& options =
 /// (analyzeTopology), indices in range.
 std::size_t flipZeroAreaFaces(TriangleMesh& mesh);
 
+/// flipZeroAreaFaces for faces that are only nearly flat: a face whose corner m lies within
+/// `relativeHeight` × |ab| of the line of its longest edge ab (a cap: CAD tessellations leave them where a
+/// vertex sits just off a neighbour's edge) is flipped as there, under the same conditions, with "zero
+/// area" read as "this thin". The vertices stay where they are; the surface moves by at most m's height
+/// over ab, and the volume by at most a third of that height times the area of the face across ab, per
+/// flip. flipZeroAreaFaces is flipThinFaces with a relative height of 1e-12. Precondition: as there;
+/// relativeHeight ≥ 0.
+std::size_t flipThinFaces(TriangleMesh& mesh, double relativeHeight);
+
 /// Removes faces with a repeated vertex index (they have no area and no proper edges) and returns how
 /// many were removed. Zero-area faces with distinct vertices stay: they may close a T-junction.
 std::size_t removeRepeatedVertexFaces(TriangleMesh& mesh);
