@@ -405,7 +405,7 @@ int runAdd(const AddOptions& o) {
   if (!ids) {
     std::string hint = flagHint(ids.error());
     // TetGen refused or crashed on a surface: the level set --repair makes of it is a clean one, which
-    // meshes where this did not (a CAD part whose lobes meet along an edge, say).
+    // meshes where this did not (a scan whose surface folds through itself, say).
     if (hint.empty() && computeFailed && !o.load.repair &&
         (ids.error().code == ErrorCode::kParse || ids.error().code == ErrorCode::kIo))
       hint =

@@ -64,6 +64,12 @@ std::vector<double> wallVolumeBounds(const TriangleMesh& surface, const Tetrahed
 
 namespace {
 
+/// A face whose corner across its longest edge lies within this much of the edge's length from its line
+/// is a cap, which tetrahedralize flips away when TetGen's tets of the surface as given fall apart.
+constexpr double kCapHeight = 1e-4;
+/// ... and only if the flips change the volume by at most this much of it.
+constexpr double kCapVolume = 1e-6;
+
 /// Names the first crossing of a surface that TetGen could not mesh, and what TetGen did.
 std::string selfIntersectionMessage(const std::vector<core::TriangleCrossing>& crossings,
                                     const Error& tetgen) {
@@ -198,7 +204,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   auto mass = core::computeMassProperties(surface);
   if (!mass) return mass.error();
   // Per triangle: the same for every run below, the turned surface's included (its triangles are these,
-  // and its volume bounds the same).
+  // and its volume bounds the same), and the capless one's (its flipped faces lie where these did).
   const std::vector<double> wallBounds = wallVolumeBounds(surface, options, mass->volume);
   auto shells = shellsToMesh(surface);
   if (!shells) return shells.error();
@@ -226,7 +232,7 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
       Result<TetMesh> unmerged = once(input, holes, inputMass, o, /*mergeFacets=*/false);
       if (unmerged) return unmerged;
       // Both said why: the merged run often only that merging moved the surface, the unmerged one what is
-      // wrong with the tets themselves (a CAD part whose two lobes meet along an edge: two pieces).
+      // wrong with the tets themselves (pieces that meet only at edges once the flat ones are dropped).
       if (unmerged.error().message != result.error().message)
         return Result<TetMesh>(
             Error{unmerged.error().code,
@@ -253,48 +259,68 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
                      "solid, so give each its own mesh, or, where they are parts that touch, --repair joins "
                      "them into one"};
   if (!options.relaxOnFailure) return tets;
-  // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
-  // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
-  for (double relaxed : {2.5, 0.0}) {
-    if (tets || options.maxRadiusEdgeRatio == 0.0 || (relaxed > 0.0 && options.maxRadiusEdgeRatio >= relaxed))
-      continue;
-    TetrahedralizeOptions looser = options;
-    looser.maxRadiusEdgeRatio = relaxed;
-    looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
-    tets = attempt(looser);
-  }
-  if (tets) return tets;
-  // TetGen 1.5.0 asserts in its point location ("finddirection: nonconvex") on some surfaces whose
-  // vertices are symmetric about the coordinate planes: two uv-ellipsoids of 12 segments and 6 stacks in
-  // the default catalog did, at every bound. The same surface turned by a generic rotation meshes; its
-  // nodes are turned back and the surface's own vertices (TetGen keeps them first, in order) restored
-  // exactly, so that the tets fill the surface as any run's do.
-  const core::Mat3 turn = Eigen::AngleAxisd(0.37, core::Vec3(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
-  TriangleMesh turned = surface;
-  for (core::Vec3& v : turned.vertices)
-    v = turn * v;
-  const auto turnedMass = core::computeMassProperties(turned);
-  if (!turnedMass) return tets;
-  std::vector<core::Vec3> turnedHoles = shells->holes;
-  for (core::Vec3& h : turnedHoles)
-    h = turn * h;
-  Result<TetMesh> turnedTets = attemptOn(turned, turnedHoles, *turnedMass, options);
-  if (!turnedTets) return tets;
-  TetMesh back = std::move(turnedTets).value();
-  if (back.nodes.size() < surface.vertices.size()) return tets;
-  const double tolerance = 1e-9 * std::cbrt(mass->volume);
-  for (std::size_t i = 0; i < back.nodes.size(); ++i) {
-    const core::Vec3 node = turn.transpose() * back.nodes[i];
-    if (i >= surface.vertices.size()) {
-      back.nodes[i] = node;
-    } else if ((node - surface.vertices[i]).norm() <= tolerance) {
-      back.nodes[i] = surface.vertices[i];
-    } else {
-      return tets;  // not the surface's vertex: TetGen numbered them otherwise
+  // The fallbacks below, for a surface as given and for one with its caps flipped.
+  // `out`: the error to give if none of them meshes `input` (a looser run's replaces it).
+  const auto relaxed = [&](const TriangleMesh& input, const core::MassProperties& inputMass,
+                           Result<TetMesh> out) -> Result<TetMesh> {
+    // TetGen's quality refinement can abort, hang or return a flat tet near sharp input angles (a slender
+    // cone's tip did, 4 times in the 4,500-entry catalog): a looser bound, then none.
+    for (double looseness : {2.5, 0.0}) {
+      if (options.maxRadiusEdgeRatio == 0.0 || (looseness > 0.0 && options.maxRadiusEdgeRatio >= looseness))
+        continue;
+      TetrahedralizeOptions looser = options;
+      looser.maxRadiusEdgeRatio = looseness;
+      looser.timeoutSeconds = std::min(looser.timeoutSeconds, 10.0);
+      out = attemptOn(input, shells->holes, inputMass, looser);
+      if (out) return out;
     }
-  }
-  if (!core::validateTetMesh(back) || !fillsSurface(back, *mass)) return tets;  // flat, inverted, moved
-  return back;
+    // TetGen 1.5.0 asserts in its point location ("finddirection: nonconvex") on some surfaces whose
+    // vertices are symmetric about the coordinate planes: two uv-ellipsoids of 12 segments and 6 stacks in
+    // the default catalog did, at every bound. The same surface turned by a generic rotation meshes; its
+    // nodes are turned back and the surface's own vertices (TetGen keeps them first, in order) restored
+    // exactly, so that the tets fill the surface as any run's do.
+    const core::Mat3 turn =
+        Eigen::AngleAxisd(0.37, core::Vec3(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+    TriangleMesh turned = input;
+    for (core::Vec3& v : turned.vertices)
+      v = turn * v;
+    const auto turnedMass = core::computeMassProperties(turned);
+    if (!turnedMass) return out;
+    std::vector<core::Vec3> turnedHoles = shells->holes;
+    for (core::Vec3& h : turnedHoles)
+      h = turn * h;
+    Result<TetMesh> turnedTets = attemptOn(turned, turnedHoles, *turnedMass, options);
+    if (!turnedTets) return out;
+    TetMesh back = std::move(turnedTets).value();
+    if (back.nodes.size() < input.vertices.size()) return out;
+    const double tolerance = 1e-9 * std::cbrt(inputMass.volume);
+    for (std::size_t i = 0; i < back.nodes.size(); ++i) {
+      const core::Vec3 node = turn.transpose() * back.nodes[i];
+      if (i >= input.vertices.size()) {
+        back.nodes[i] = node;
+      } else if ((node - input.vertices[i]).norm() <= tolerance) {
+        back.nodes[i] = input.vertices[i];
+      } else {
+        return out;  // not the surface's vertex: TetGen numbered them otherwise
+      }
+    }
+    if (!core::validateTetMesh(back) || !fillsSurface(back, inputMass)) return out;  // flat, inverted, moved
+    return back;
+  };
+  tets = relaxed(surface, *mass, std::move(tets));
+  if (tets) return tets;
+  // A cap, a face whose corner lies a hair off the line of its longest edge (a CAD part's tessellation
+  // had three, their corners 5e-6 to 2e-5 of their edges' lengths off them), makes TetGen's refinement run
+  // away around it, down to tets a millionth of the solid's size, which dropFlatTets takes for flat: the tets
+  // fall apart into pieces. The surface with its caps flipped away (kCapHeight; the vertices stay, the
+  // surface moves by less than that) is meshed instead, if its volume is the surface's within kCapVolume.
+  TriangleMesh capless = surface;
+  if (core::flipThinFaces(capless, kCapHeight) == 0) return tets;
+  const auto caplessMass = core::computeMassProperties(capless);
+  if (!caplessMass || !(std::abs(caplessMass->volume / mass->volume - 1.0) <= kCapVolume)) return tets;
+  Result<TetMesh> flipped = attemptOn(capless, shells->holes, *caplessMass, options);
+  if (!flipped) flipped = relaxed(capless, *caplessMass, std::move(flipped));
+  return flipped ? std::move(flipped) : std::move(tets);
 }
 
 // A surface whose faces are only nearly coplanar (a level-set mesh: float coordinates) leaves wedges of

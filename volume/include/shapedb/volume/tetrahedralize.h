@@ -52,7 +52,12 @@ std::vector<double> wallVolumeBounds(const core::TriangleMesh& surface, const Te
 /// tetrahedralization of the surface as a piecewise linear complex, refined to the quality bounds). The
 /// tets fill the surface exactly: their boundary lies on the input faces, so their volume integrals
 /// equal the surface integrals to round-off; a run whose tets do not (volume or centroid off by more than
-/// 1e-9: TetGen merged nearly coplanar facets) is repeated with merging off.
+/// 1e-9: TetGen merged nearly coplanar facets) is repeated with merging off. With relaxOnFailure, where
+/// every run fails and the surface has caps (faces whose corner lies within 1e-4 of the opposite edge's
+/// length from it, around which TetGen's refinement runs away until its tets fall apart), the surface with
+/// them flipped away (core::flipThinFaces) is meshed the same way instead: the tets then fill that surface,
+/// which has the same vertices, lies within the caps' heights of the given one, and holds its volume
+/// within 1e-6.
 ///
 /// The input is validated first (finite, indices in range, no degenerate face, closed, consistently and
 /// outward oriented, positive volume): TetGen is never handed a mesh it is known to choke on. Errors: the
