@@ -201,12 +201,21 @@ int main(int argc, char** argv) {
     if (a.upgraded) {
       std::snprintf(exact, sizeof exact, "%.1f s", a.upgradeSeconds);
       exactSeconds.push_back(a.upgradeSeconds);
+    } else if (!a.upgradeError.empty()) {
+      std::snprintf(exact, sizeof exact, "failed (below)");
     }
     std::printf("| %s | %.1f Hz | %s | %s | %s | %s |\n", name.c_str(), truth.at(name),
                 percent(first[i]).c_str(), percent(second[i]).c_str(), exact,
                 b.state == haptics::ObjectOutcome::State::kReady
                     ? (b.upgraded ? (b.firstSource + ", then learned").c_str() : b.source.c_str())
                     : "not reached");
+  }
+  // Why an object's exact data did not come: its augmentation or its upgrade failed.
+  for (const haptics::ObjectOutcome& o : with.objects) {
+    if (o.state == haptics::ObjectOutcome::State::kFailed)
+      std::printf("%s: not augmented: %s\n", o.name.c_str(), o.error.c_str());
+    if (!o.upgradeError.empty())
+      std::printf("%s: upgrade failed: %s\n", o.name.c_str(), o.upgradeError.c_str());
   }
   const auto absolute = [](std::vector<double> v) {
     for (double& x : v)
