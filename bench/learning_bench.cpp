@@ -12,9 +12,12 @@
 //   - the second appearance's: the answer once learning ran (a query after the loop);
 //   - the time to exact data: entering the radius → the learned data in use in the loop;
 //   - the loop's deadline misses with learning running, beside those of the same loop without learning
-//     and of an empty loop (the platform's own).
+//     and of an empty loop (the platform's own); for each loop, how late its ticks started, the loop
+//     thread's page faults, and the hypervisor's steal time meanwhile (on a virtual machine a vCPU the
+//     host takes away for milliseconds makes ticks late with no cause in this process).
 // Meshes are read in metres, as `shapedb bench` read them for its truth.
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,6 +25,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <unistd.h>
 #include <utility>
 #include <vector>
 
@@ -84,6 +88,21 @@ std::string percent(double x) {
   char b[32];
   std::snprintf(b, sizeof b, std::isfinite(x) ? "%+.1f %%" : "n/a", 100.0 * x);
   return b;
+}
+
+/// The time the hypervisor ran something else while this machine's CPUs had work (steal, all CPUs summed,
+/// from /proc/stat), in seconds since boot; NaN where the system does not say. A tick that starts late with
+/// no page fault while steal grows was lost to the host, not to this process.
+double stealSeconds() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  double field = 0.0, steal = 0.0;
+  if (!(in >> cpu) || cpu != "cpu") return std::nan("");
+  for (int i = 0; i < 8; ++i) {  // user nice system idle iowait irq softirq steal
+    if (!(in >> field)) return std::nan("");
+    steal = field;
+  }
+  return steal / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 }  // namespace
@@ -171,18 +190,25 @@ int main(int argc, char** argv) {
               meshes.size(), positional[0].c_str(), db->size(), sweepSeconds, length / sweepSeconds);
   haptics::TrajectoryDevice still = *haptics::TrajectoryDevice::fromKeyframes({{0.0, Vec3::Zero()}});
   const auto empty = haptics::HapticLoop::create({}, still, haptics::databaseAugmenter(*db, query), options);
+  std::array<double, 3> steal{};  // during each loop, seconds
+  double stealBefore = stealSeconds();
   const haptics::LoopReport base = (*empty)->run(sweepSeconds);
+  steal[0] = stealSeconds() - stealBefore;
   haptics::TrajectoryDevice plainDevice = device();
   const auto plain =
       haptics::HapticLoop::create(objects, plainDevice, haptics::databaseAugmenter(*db, query), options);
+  stealBefore = stealSeconds();
   const haptics::LoopReport without = (*plain)->run(sweepSeconds);
+  steal[1] = stealSeconds() - stealBefore;
   haptics::LoopReport with;
   {
     io::Enricher enricher(*db);
     haptics::TrajectoryDevice learningDevice = device();
     const auto learning = haptics::HapticLoop::create(
         objects, learningDevice, haptics::learningAugmenter(*db, enricher, query), options);
+    stealBefore = stealSeconds();
     with = (*learning)->run(sweepSeconds);
+    steal[2] = stealSeconds() - stealBefore;
     enricher.wait();  // the rest, for the second appearances below
   }
 
@@ -239,13 +265,17 @@ int main(int argc, char** argv) {
       with.tickMicros.max);
   // Why a tick misses: it ran long, it started late (the loop thread waited for a core, or for the memory
   // map in a page fault), or both.
-  for (const auto& [name, r] :
-       {std::pair{"empty loop", &base}, {"without learning", &without}, {"with learning", &with}})
+  const std::array<std::pair<const char*, const haptics::LoopReport*>, 3> loops = {
+      {{"empty loop", &base}, {"without learning", &without}, {"with learning", &with}}};
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    const auto& [name, r] = loops[i];
     std::printf(
         "  %s: tick start late us p50 %.1f, p99 %.1f, max %.0f; loop thread page faults %zu; "
-        "real-time priority %s\n",
+        "real-time priority %s; hypervisor steal %s\n",
         name, r->startLateMicros.p50, r->startLateMicros.p99, r->startLateMicros.max, r->pageFaults,
-        r->realtimePriority ? "yes" : "no");
+        r->realtimePriority ? "yes" : "no",
+        std::isfinite(steal[i]) ? (std::to_string(std::lround(1e3 * steal[i])) + " ms").c_str() : "unknown");
+  }
   fs::remove(work);
   return 0;
 }
