@@ -6,6 +6,8 @@
 #include <numeric>
 #include <utility>
 
+#include <tbb/parallel_for.h>
+
 #include <shapedb/core/spatial.h>
 
 namespace shapedb::core {
@@ -97,6 +99,9 @@ std::vector<double> wallThickness(const TriangleMesh& surface) {
 namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
+/// A ClosestPointTree node over at least this many triangles builds its children in parallel: below it a
+/// task costs more than it saves.
+constexpr std::uint32_t kParallelBuild = 8192;
 
 // The nearest float at or below x, and at or above it: a box rounded outward still holds what the
 // double one did. Beyond float's range, the largest float or infinity (a conversion there is undefined).
@@ -196,6 +201,7 @@ std::array<std::uint32_t, 4> childSizes(std::uint32_t n, int& count) {
 // How many nodes build() makes for n triangles, which follows from n alone (reserved exactly: a vector
 // that grew would hold both buffers at once).
 std::size_t treeNodeCount(std::uint32_t n, std::map<std::uint32_t, std::size_t>& memo) {
+  // Every size build() meets is entered, so that it can look up where each subtree goes.
   if (auto it = memo.find(n); it != memo.end()) return it->second;
   int children = 0;
   const std::array<std::uint32_t, 4> sizes = childSizes(n, children);
@@ -209,7 +215,7 @@ std::size_t treeNodeCount(std::uint32_t n, std::map<std::uint32_t, std::size_t>&
 
 }  // namespace
 
-ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) {
+ClosestPointTree::ClosestPointTree(const TriangleMesh& surface, bool parallel) {
   const auto n = static_cast<std::uint32_t>(surface.triangles.size());
   if (n == 0) return;
   mOrder.resize(n);
@@ -219,10 +225,10 @@ ClosestPointTree::ClosestPointTree(const TriangleMesh& surface) {
       const auto& tri = surface.triangles[t];
       items[t] = {(surface.vertices[tri[0]] + surface.vertices[tri[1]] + surface.vertices[tri[2]]) / 3.0, t};
     }
-    std::map<std::uint32_t, std::size_t> memo;
-    mNodes.reserve(treeNodeCount(n, memo));
+    NodeCounts counts;
+    mNodes.resize(treeNodeCount(n, counts));
     std::array<float, 3> lo{}, hi{};
-    build(0, n, surface, items, lo, hi);
+    build(0, 0, n, surface, items, counts, parallel, lo, hi);
     for (std::uint32_t i = 0; i < n; ++i)
       mOrder[i] = items[i].triangle;
   }
@@ -255,12 +261,13 @@ TrianglePoint ClosestPointTree::closestOnTriangle(const Vec3& p, std::uint32_t p
 
 // A node over items[begin, end): halved at the median centroid along the centroids' longest extent, and
 // each half over a leaf's size halved again; each part a leaf or a node of its own. Boxes are merged
-// bottom-up, so each triangle's corners are read once, at its leaf.
-std::uint32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
-                                      std::vector<Keyed>& items, std::array<float, 3>& lo,
-                                      std::array<float, 3>& hi) {
-  const auto index = static_cast<std::uint32_t>(mNodes.size());
-  mNodes.emplace_back();
+// bottom-up, so each triangle's corners are read once, at its leaf. A subtree's node count follows from
+// its size, so each child's place is known before it is built: the children of a node over
+// kParallelBuild triangles or more are built at once, each into its own range of mNodes and of items, and
+// the tree is the one a serial build makes.
+void ClosestPointTree::build(std::uint32_t index, std::uint32_t begin, std::uint32_t end,
+                             const TriangleMesh& surface, std::vector<Keyed>& items, const NodeCounts& counts,
+                             bool parallel, std::array<float, 3>& lo, std::array<float, 3>& hi) {
   {
     Node& node = mNodes[index];
     for (auto& axis : node.min)
@@ -294,38 +301,49 @@ std::uint32_t ClosestPointTree::build(std::uint32_t begin, std::uint32_t end, co
       bounds[++parts] = e;
     }
   }
+  // Where each part's subtree goes (a leaf's triangles stay where they are).
+  std::array<std::uint32_t, 4> place{};
+  std::size_t next = index + 1;
+  for (std::size_t c = 0; c < parts; ++c)
+    if (const std::uint32_t count = bounds[c + 1] - bounds[c]; count > kLeafSize) {
+      place[c] = static_cast<std::uint32_t>(next);
+      next += counts.at(count);
+    }
+  std::array<std::array<float, 3>, 4> clo{}, chi{};
+  const auto part = [&](std::size_t c) {
+    const std::uint32_t b = bounds[c], e = bounds[c + 1];
+    if (e - b > kLeafSize) return build(place[c], b, e, surface, items, counts, parallel, clo[c], chi[c]);
+    Vec3 dlo = Vec3::Constant(std::numeric_limits<double>::infinity()), dhi = -dlo;
+    for (std::uint32_t i = b; i < e; ++i)
+      for (std::uint32_t v : surface.triangles[items[i].triangle]) {
+        dlo = dlo.cwiseMin(surface.vertices[v]);
+        dhi = dhi.cwiseMax(surface.vertices[v]);
+      }
+    for (int a = 0; a < 3; ++a) {
+      clo[c][static_cast<std::size_t>(a)] = floatBelow(dlo[a]);
+      chi[c][static_cast<std::size_t>(a)] = floatAbove(dhi[a]);
+    }
+  };
+  if (parallel && end - begin >= kParallelBuild) {
+    tbb::parallel_for(std::size_t{0}, parts, part);
+  } else {
+    for (std::size_t c = 0; c < parts; ++c)
+      part(c);
+  }
   lo.fill(kFloatInfinity);
   hi.fill(-kFloatInfinity);
+  Node& node = mNodes[index];
   for (std::size_t c = 0; c < parts; ++c) {
-    const std::uint32_t b = bounds[c], e = bounds[c + 1];
-    std::array<float, 3> clo{}, chi{};
-    std::uint32_t child = b, count = e - b;
-    if (count <= kLeafSize) {
-      Vec3 dlo = Vec3::Constant(std::numeric_limits<double>::infinity()), dhi = -dlo;
-      for (std::uint32_t i = b; i < e; ++i)
-        for (std::uint32_t v : surface.triangles[items[i].triangle]) {
-          dlo = dlo.cwiseMin(surface.vertices[v]);
-          dhi = dhi.cwiseMax(surface.vertices[v]);
-        }
-      for (int a = 0; a < 3; ++a) {
-        clo[static_cast<std::size_t>(a)] = floatBelow(dlo[a]);
-        chi[static_cast<std::size_t>(a)] = floatAbove(dhi[a]);
-      }
-    } else {
-      child = build(b, e, surface, items, clo, chi);
-      count = 0;
-    }
-    Node& node = mNodes[index];
-    node.child[c] = child;
-    node.count[c] = count;
+    const std::uint32_t count = bounds[c + 1] - bounds[c];
+    node.child[c] = count > kLeafSize ? place[c] : bounds[c];
+    node.count[c] = count > kLeafSize ? 0 : count;
     for (std::size_t a = 0; a < 3; ++a) {
-      node.min[a][c] = clo[a];
-      node.max[a][c] = chi[a];
-      lo[a] = std::min(lo[a], clo[a]);
-      hi[a] = std::max(hi[a], chi[a]);
+      node.min[a][c] = clo[c][a];
+      node.max[a][c] = chi[c][a];
+      lo[a] = std::min(lo[a], clo[c][a]);
+      hi[a] = std::max(hi[a], chi[c][a]);
     }
   }
-  return index;
 }
 
 ClosestPointTree::Hit ClosestPointTree::closest(const Vec3& p) const {

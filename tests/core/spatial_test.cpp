@@ -118,6 +118,40 @@ TEST(ClosestPointTree, FirstHitAgreesWithEveryTriangle) {
   }
 }
 
+// A tree over tens of thousands of triangles builds its large subtrees on several threads. It is the tree
+// a build on the calling thread alone makes: every closest point and first hit the same to the bit (the
+// triangle named too), and on a sample of the points the closest of every triangle (the oracle).
+TEST(ClosestPointTree, ALargeTreeBuiltOnSeveralThreadsIsTheOneBuiltOnOne) {
+  std::mt19937_64 rng(11);
+  const TriangleMesh surface =
+      transformed(makeUvEllipsoid({1.0, 0.5, 0.3}, 160, 100), test::randomSimilarity(rng));
+  ASSERT_GT(surface.triangleCount(), 30000u);
+  const ClosestPointTree parallel(surface), serial(surface, /*parallel=*/false);
+  ASSERT_EQ(parallel.triangleCount(), serial.triangleCount());
+  const Bounds b = computeBounds(surface);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 p = b.min + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(b.extent());
+    const ClosestPointTree::Hit x = parallel.closest(p), y = serial.closest(p);
+    ASSERT_EQ(x.triangle, y.triangle) << "point " << i;
+    ASSERT_EQ(x.closest.squaredDistance, y.closest.squaredDistance) << "point " << i;
+    const Vec3 direction = Vec3(u(rng), u(rng), u(rng)) - Vec3::Constant(0.5);
+    const auto hx = parallel.firstHit(p, direction), hy = serial.firstHit(p, direction);
+    ASSERT_EQ(hx.has_value(), hy.has_value()) << "point " << i;
+    if (hx) {
+      ASSERT_EQ(hx->triangle, hy->triangle) << "point " << i;
+      ASSERT_EQ(hx->distance, hy->distance) << "point " << i;
+    }
+    if (i % 20 != 0) continue;
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& t : surface.triangles)
+      best = std::min(best, closestPointOnTriangle(p, surface.vertices[t[0]], surface.vertices[t[1]],
+                                                   surface.vertices[t[2]])
+                                .squaredDistance);
+    ASSERT_EQ(x.closest.squaredDistance, best) << "point " << i;
+  }
+}
+
 // A plate's thickness is its thinnest side at every vertex, corners included; a ball's is its diameter
 // wherever the rays pass near its centre.
 // Every size of tree from one triangle up: a node holds one to four children, leaves of up to four

@@ -57,7 +57,8 @@ TetGenOutput runTetGen(const TriangleMesh& surface, const std::vector<double>& m
       in.pointlist[3 * i + static_cast<std::size_t>(k)] = surface.vertices[i][k];
   core::ClosestPointTree tree;
   if (!maxVolumes.empty()) {
-    tree = core::ClosestPointTree(surface);
+    // Serial: this runs in TetGen's forked worker too, which has none of the parent's TBB threads.
+    tree = core::ClosestPointTree(surface, /*parallel=*/false);
     tLocalBound = {&tree, &maxVolumes};
     in.tetunsuitable = &overLocalVolumeBound;
   }

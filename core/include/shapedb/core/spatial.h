@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -46,7 +47,10 @@ double rayTriangleDistance(const Vec3& origin, const Vec3& direction, const Vec3
 class ClosestPointTree {
  public:
   ClosestPointTree() = default;
-  explicit ClosestPointTree(const TriangleMesh& surface);
+  /// The tree of `surface`'s triangles. A large surface's is built on several threads (TBB), unless
+  /// `parallel` is false: a process forked from one that runs TBB (TetGen's worker) has none of its
+  /// threads, and must not use it. The tree is the same either way.
+  explicit ClosestPointTree(const TriangleMesh& surface, bool parallel = true);
 
   struct Hit {
     std::uint32_t triangle = 0;  ///< index in the surface the tree was built from
@@ -87,9 +91,14 @@ class ClosestPointTree {
     Vec3 centroid;
     std::uint32_t triangle;
   };
-  /// Builds the node of triangles items[begin, end) and returns its index; `lo`, `hi` get its box.
-  std::uint32_t build(std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
-                      std::vector<Keyed>& items, std::array<float, 3>& lo, std::array<float, 3>& hi);
+  /// Node counts by number of triangles (a subtree's shape follows from its size alone).
+  using NodeCounts = std::map<std::uint32_t, std::size_t>;
+  /// Builds the node of triangles items[begin, end) at mNodes[index], its subtrees after it in depth-first
+  /// order; `lo`, `hi` get its box. With `parallel`, large subtrees are built at once, into the places a
+  /// serial build gives them.
+  void build(std::uint32_t index, std::uint32_t begin, std::uint32_t end, const TriangleMesh& surface,
+             std::vector<Keyed>& items, const NodeCounts& counts, bool parallel, std::array<float, 3>& lo,
+             std::array<float, 3>& hi);
   Hit search(const Vec3& p, Hit best, double bestSq) const;
   std::vector<std::uint32_t> mOrder;                     ///< triangle indices, leaves contiguous
   std::vector<std::uint32_t> mPosition;                  ///< inverse of mOrder: where triangle t sits
