@@ -198,10 +198,10 @@ std::array<std::uint32_t, 4> childSizes(std::uint32_t n, int& count) {
   return sizes;
 }
 
-// How many nodes build() makes for n triangles, which follows from n alone (reserved exactly: a vector
-// that grew would hold both buffers at once).
+// How many nodes build() makes for n triangles, which follows from n alone (the node array is sized
+// exactly once), memoized: every subtree size build() meets is entered, so that it can look up where
+// each subtree goes.
 std::size_t treeNodeCount(std::uint32_t n, std::map<std::uint32_t, std::size_t>& memo) {
-  // Every size build() meets is entered, so that it can look up where each subtree goes.
   if (auto it = memo.find(n); it != memo.end()) return it->second;
   int children = 0;
   const std::array<std::uint32_t, 4> sizes = childSizes(n, children);

@@ -17,7 +17,6 @@ bool hasRepeatedVertex(const TriangleMesh::Triangle& t) {
   return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
 }
 
-// Zero area relative to the triangle's own size: twice the area below 1e-12 of its longest edge squared.
 /// Whether the corner of `t` across its longest edge lies within relativeHeight × that edge's length of
 /// its line (twice the area is the longest edge times that height).
 bool isThin(const TriangleMesh& mesh, const TriangleMesh::Triangle& t, double relativeHeight) {
@@ -30,6 +29,7 @@ bool isThin(const TriangleMesh& mesh, const TriangleMesh::Triangle& t, double re
 
 constexpr double kZeroAreaHeight = 1e-12;
 
+// Zero area relative to the triangle's own size: twice the area below 1e-12 of its longest edge squared.
 bool hasZeroArea(const TriangleMesh& mesh, const TriangleMesh::Triangle& t) {
   return isThin(mesh, t, kZeroAreaHeight);
 }
