@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -162,6 +163,41 @@ TEST(Topology, ShellsAreSignedByTheirWinding) {
   EXPECT_GT(one[0].volume, 4.0);  // a bit under 4π/3 = 4.19
 }
 
+// A T-junction on a random face abx of closed, oriented `original` (as it stands in `mesh`, which has
+// original's faces first): a vertex m put on the edge ab, 0.2 to 0.8 along it and lifted lift·|ab| off it
+// into abx (0: on it), abx split into amx and mbx, and the face abm (wound a → b against the other side's
+// b → a) closing the surface again. Neither abx nor the face across ab may be `used`; both are marked.
+// The area of the face across ab, or nothing when a used face was drawn.
+std::optional<double> addJunction(TriangleMesh& mesh, const TriangleMesh& original, std::vector<char>& used,
+                                  double lift, std::mt19937_64& rng) {
+  const auto t = static_cast<std::uint32_t>(rng() % original.triangles.size());
+  if (used[t]) return std::nullopt;
+  const int k = static_cast<int>(rng() % 3);
+  const std::uint32_t a = original.triangles[t][k], b = original.triangles[t][(k + 1) % 3],
+                      x = original.triangles[t][(k + 2) % 3];
+  std::size_t across = 0;  // the face with the edge b → a
+  for (; across < original.triangles.size(); ++across) {
+    const auto& f = original.triangles[across];
+    if ((f[0] == b && f[1] == a) || (f[1] == b && f[2] == a) || (f[2] == b && f[0] == a)) break;
+  }
+  EXPECT_LT(across, original.triangles.size());
+  if (across == original.triangles.size() || used[across]) return std::nullopt;
+  used[t] = used[across] = 1;
+  const Vec3 &pa = original.vertices[a], &pb = original.vertices[b], &px = original.vertices[x];
+  const double where = std::uniform_real_distribution<double>(0.2, 0.8)(rng);
+  const Vec3 ab = pb - pa;
+  const Vec3 inward = ((px - pa) - (px - pa).dot(ab) / ab.squaredNorm() * ab).normalized();
+  const auto m = static_cast<std::uint32_t>(mesh.vertices.size());
+  mesh.vertices.push_back((1.0 - where) * pa + where * pb + lift * ab.norm() * inward);
+  mesh.triangles[t] = {a, m, x};
+  mesh.triangles.push_back({m, b, x});
+  mesh.triangles.push_back({a, b, m});
+  const auto& f = original.triangles[across];
+  return 0.5 * (original.vertices[f[1]] - original.vertices[f[0]])
+                   .cross(original.vertices[f[2]] - original.vertices[f[0]])
+                   .norm();
+}
+
 // T-junctions, as CAD tessellations and STL exports leave them: a vertex m put on an edge ab of a closed
 // surface on one side only (the triangle abx split into amx and mbx), and the zero-area face abm that
 // closes the surface again. Flipped away, on random surfaces with random such junctions: no zero-area face
@@ -191,31 +227,8 @@ TEST(Topology, ZeroAreaFacesOfTJunctionsAreFlippedAwayLeavingTheSameSurface) {
     const int junctions = 1 + static_cast<int>(rng() % 6);
     int made = 0;
     std::vector<char> used(original.triangles.size(), 0);  // split, or across a split edge
-    for (int tries = 0; made < junctions && tries < 100; ++tries) {
-      const auto t = static_cast<std::uint32_t>(rng() % original.triangles.size());
-      if (used[t]) continue;
-      const int k = static_cast<int>(rng() % 3);
-      const std::uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3],
-                          x = mesh.triangles[t][(k + 2) % 3];
-      std::size_t across = 0;
-      while (across < original.triangles.size() &&
-             !(std::find(original.triangles[across].begin(), original.triangles[across].end(), a) !=
-                   original.triangles[across].end() &&
-               std::find(original.triangles[across].begin(), original.triangles[across].end(), b) !=
-                   original.triangles[across].end() &&
-               across != t))
-        ++across;
-      ASSERT_LT(across, original.triangles.size());
-      if (used[across]) continue;
-      used[t] = used[across] = 1;
-      const double where = std::uniform_real_distribution<double>(0.2, 0.8)(rng);
-      const auto m = static_cast<std::uint32_t>(mesh.vertices.size());
-      mesh.vertices.push_back((1.0 - where) * mesh.vertices[a] + where * mesh.vertices[b]);
-      mesh.triangles[t] = {a, m, x};
-      mesh.triangles.push_back({m, b, x});
-      mesh.triangles.push_back({a, b, m});  // the filler: a → b against the other side's b → a
-      ++made;
-    }
+    for (int tries = 0; made < junctions && tries < 100; ++tries)
+      if (addJunction(mesh, original, used, 0.0, rng)) ++made;
     ASSERT_GT(made, 0);
     const TopologyReport before = analyzeTopology(mesh);
     ASSERT_TRUE(before.isClosed() && before.isConsistentlyOriented());
@@ -252,35 +265,12 @@ TEST(Topology, CapsAreFlippedAwayMovingTheSurfaceByNoMoreThanTheirHeights) {
     int made = 0;
     double bound = 0.0;
     for (int tries = 0; made < 4 && tries < 100; ++tries) {
-      const auto t = static_cast<std::uint32_t>(rng() % original.triangles.size());
-      if (used[t]) continue;
-      const int k = static_cast<int>(rng() % 3);
-      const std::uint32_t a = original.triangles[t][k], b = original.triangles[t][(k + 1) % 3],
-                          x = original.triangles[t][(k + 2) % 3];
-      std::size_t across = 0;  // the face with the edge b → a
-      for (; across < original.triangles.size(); ++across) {
-        const auto& f = original.triangles[across];
-        if ((f[0] == b && f[1] == a) || (f[1] == b && f[2] == a) || (f[2] == b && f[0] == a)) break;
-      }
-      ASSERT_LT(across, original.triangles.size());
-      if (used[across]) continue;
-      used[t] = used[across] = 1;
-      const Vec3 &pa = original.vertices[a], &pb = original.vertices[b], &px = original.vertices[x];
-      const double where = std::uniform_real_distribution<double>(0.2, 0.8)(rng);
       const double lift = std::pow(10.0, std::uniform_real_distribution<double>(-7.0, -5.0)(rng));
-      const Vec3 onEdge = (1.0 - where) * pa + where * pb;
-      const Vec3 ab = pb - pa;
-      const Vec3 inward = ((px - pa) - (px - pa).dot(ab) / ab.squaredNorm() * ab).normalized();
-      const auto m = static_cast<std::uint32_t>(mesh.vertices.size());
-      mesh.vertices.push_back(onEdge + lift * ab.norm() * inward);
-      mesh.triangles[t] = {a, m, x};
-      mesh.triangles.push_back({m, b, x});
-      mesh.triangles.push_back({a, b, m});  // the cap
-      const auto& f = original.triangles[across];
-      const double acrossArea = 0.5 * (original.vertices[f[1]] - original.vertices[f[0]])
-                                          .cross(original.vertices[f[2]] - original.vertices[f[0]])
-                                          .norm();
-      bound += lift * ab.norm() * acrossArea / 3.0;
+      const std::optional<double> acrossArea = addJunction(mesh, original, used, lift, rng);
+      if (!acrossArea) continue;
+      // The cap abm is the last face added: m lies lift·|ab| off ab.
+      const auto& cap = mesh.triangles.back();
+      bound += lift * (mesh.vertices[cap[1]] - mesh.vertices[cap[0]]).norm() * *acrossArea / 3.0;
       ++made;
     }
     ASSERT_GT(made, 0);
