@@ -190,25 +190,25 @@ int main(int argc, char** argv) {
               meshes.size(), positional[0].c_str(), db->size(), sweepSeconds, length / sweepSeconds);
   haptics::TrajectoryDevice still = *haptics::TrajectoryDevice::fromKeyframes({{0.0, Vec3::Zero()}});
   const auto empty = haptics::HapticLoop::create({}, still, haptics::databaseAugmenter(*db, query), options);
-  std::array<double, 3> steal{};  // during each loop, seconds
-  double stealBefore = stealSeconds();
-  const haptics::LoopReport base = (*empty)->run(sweepSeconds);
-  steal[0] = stealSeconds() - stealBefore;
+  std::array<double, 3> steal{};  // the hypervisor's during each loop, seconds
+  const auto runLoop = [&](haptics::HapticLoop& loop, std::size_t i) {
+    const double before = stealSeconds();
+    haptics::LoopReport report = loop.run(sweepSeconds);
+    steal[i] = stealSeconds() - before;
+    return report;
+  };
+  const haptics::LoopReport base = runLoop(**empty, 0);
   haptics::TrajectoryDevice plainDevice = device();
   const auto plain =
       haptics::HapticLoop::create(objects, plainDevice, haptics::databaseAugmenter(*db, query), options);
-  stealBefore = stealSeconds();
-  const haptics::LoopReport without = (*plain)->run(sweepSeconds);
-  steal[1] = stealSeconds() - stealBefore;
+  const haptics::LoopReport without = runLoop(**plain, 1);
   haptics::LoopReport with;
   {
     io::Enricher enricher(*db);
     haptics::TrajectoryDevice learningDevice = device();
     const auto learning = haptics::HapticLoop::create(
         objects, learningDevice, haptics::learningAugmenter(*db, enricher, query), options);
-    stealBefore = stealSeconds();
-    with = (*learning)->run(sweepSeconds);
-    steal[2] = stealSeconds() - stealBefore;
+    with = runLoop(**learning, 2);
     enricher.wait();  // the rest, for the second appearances below
   }
 
