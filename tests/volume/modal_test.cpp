@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -279,6 +280,28 @@ TEST(Modal, SeededLanczosAgreesWithTheDenseSolverForRandomSeeds) {
   // Seeds of the wrong size are an error.
   EXPECT_EQ(computeModesFrom(mesh, Eigen::MatrixXd::Ones(5, 2), ModalOptions{}).error().code,
             ErrorCode::kInvalidArgument);
+}
+
+// A seeded solve whose answer is no longer wanted gives up when told (ModalOptions::cancel): a flag that
+// is set ends it with kCancelled; one that stays clear changes nothing, to the bit.
+TEST(Modal, ASeededSolveGivesUpWhenCancelledAndIsUnchangedWhenNot) {
+  const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.2, 1.0, 0.7)), {.maxVolumeFraction = 1.0 / 30.0});
+  const ModalOptions options{.modes = 8, .material = core::unitMaterial(0.3)};
+  const Result<core::ModalData> reference = computeModes(mesh, options);
+  ASSERT_TRUE(reference.ok()) << reference.error().message;
+  const Result<core::ModalData> plain = computeModesFrom(mesh, reference->shapes, options);
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  std::atomic<bool> cancel{false};
+  ModalOptions cancellable = options;
+  cancellable.cancel = &cancel;
+  const Result<core::ModalData> uncancelled = computeModesFrom(mesh, reference->shapes, cancellable);
+  ASSERT_TRUE(uncancelled.ok()) << uncancelled.error().message;
+  EXPECT_EQ(uncancelled->eigenvalues, plain->eigenvalues);
+  EXPECT_EQ(uncancelled->shapes, plain->shapes);
+  cancel = true;
+  const Result<core::ModalData> cancelled = computeModesFrom(mesh, reference->shapes, cancellable);
+  ASSERT_FALSE(cancelled.ok());
+  EXPECT_EQ(cancelled.error().code, ErrorCode::kCancelled);
 }
 
 // The seeded solve is block Lanczos, which hands over to the restarted single-vector Lanczos (Spectra's)

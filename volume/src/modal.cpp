@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -655,6 +656,16 @@ Result<ModalData> solveSparse(const std::vector<core::Vec3>& nodes, const FemMat
 /// (SymmetricShiftInvert::apply).
 constexpr Eigen::Index kBlockSize = 4;
 
+/// ModalOptions::cancel has been set.
+bool cancelled(const std::atomic<bool>* cancel) {
+  return cancel && cancel->load(std::memory_order_relaxed);
+}
+
+/// What a cancelled solve ends with.
+Error cancelledError() {
+  return Error{ErrorCode::kCancelled, "the modes' solve was cancelled: its answer is no longer wanted"};
+}
+
 /// C's `nev` largest eigenvalues (descending) and their eigenvectors, by block Lanczos.
 struct RitzPairs {
   Eigen::VectorXd values;
@@ -667,15 +678,16 @@ struct RitzPairs {
 /// triangular factor of the next block, s_last the last block's rows of s. Stops once each of the `nev`
 /// largest Ritz values has a residual within `tolerance` of itself (Spectra's criterion). Empty when the
 /// basis would exceed `maxColumns` first, or a block loses rank before (C's invariant subspace reached
-/// with too few pairs in it). `solves` counts one solve per column.
+/// with too few pairs in it), or once `cancel` is true. `solves` counts one solve per column.
 std::optional<RitzPairs> blockLanczos(const SymmetricShiftInvert& op, const Eigen::MatrixXd& start,
                                       Eigen::Index nev, double tolerance, Eigen::Index maxColumns,
-                                      int& solves) {
+                                      int& solves, const std::atomic<bool>* cancel) {
   const Eigen::Index n = op.rows(), b = start.cols();
   Eigen::MatrixXd basis(n, maxColumns + b);
   basis.leftCols(b) = start;
   Eigen::MatrixXd t = Eigen::MatrixXd::Zero(maxColumns + b, maxColumns + b);
   for (Eigen::Index m = b;; m += b) {
+    if (cancelled(cancel)) return std::nullopt;
     Eigen::MatrixXd w = op.apply(basis.middleCols(m - b, b));
     solves += static_cast<int>(b);
     // Against the whole basis (classical Gram–Schmidt in blocks), a second time where a column lost
@@ -725,6 +737,7 @@ Result<ModalData> solveSeeded(const std::vector<core::Vec3>& nodes, const FemMat
   const Pencil pencil = pencilOf(nodes, fem);
   SymmetricShiftInvert op(fem.stiffness, fem.mass, pencil.rigid, pencil.sigma);
   if (!op.ok()) return factorizationError(op, fem.stiffness.rows());
+  if (cancelled(options.cancel)) return cancelledError();
   int count = 0;
   const Eigen::Index nev = options.modes;
   // The deflated space has n − 6 dimensions; the basis stays well inside it.
@@ -752,12 +765,13 @@ Result<ModalData> solveSeeded(const std::vector<core::Vec3>& nodes, const FemMat
     // Seeds that span fewer dimensions than the block (the same seed twice): the restarted solver.
     if (diagonal.minCoeff() > 1e-10 * diagonal.maxCoeff()) {
       const Eigen::MatrixXd start = qr.householderQ() * Eigen::MatrixXd::Identity(op.rows(), kBlockSize);
-      if (auto pairs = blockLanczos(op, start, nev, kSeededTolerance, maxColumns, count)) {
+      if (auto pairs = blockLanczos(op, start, nev, kSeededTolerance, maxColumns, count, options.cancel)) {
         if (solves) *solves = count;
         return modesOf(op, pencil, pairs->values, pairs->vectors, fem, options);
       }
     }
   }
+  if (cancelled(options.cancel)) return cancelledError();
   const Eigen::VectorXd sum = seeds.rowwise().sum();
   auto modes = restartedLanczos(op, pencil, fem, options, kSeededTolerance, &sum, &count);
   if (solves) *solves = count;
@@ -838,6 +852,7 @@ Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& s
   if (seeds.rows() != 3 * static_cast<Eigen::Index>(mesh.nodeCount()) || seeds.cols() < 1 ||
       !seeds.allFinite())
     return Error{ErrorCode::kInvalidArgument, "the seeds must be finite, 3 values per node of the tet mesh"};
+  if (cancelled(options.cancel)) return cancelledError();
   // Each seed M-normalized, so that every seed mode is well represented in the start (a zero seed stays
   // zero).
   const auto normalized = [](const FemMatrices& fem, Eigen::MatrixXd all) {

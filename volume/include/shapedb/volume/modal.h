@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -81,6 +82,10 @@ struct ModalOptions {
   /// beside the tets' own; empty for none. The geometry correction puts there the mass of what its
   /// morphed tets do not reach. Each must be finite and ≥ 0.
   std::vector<double> pointMasses{};
+  /// computeModesFrom only: when given, the solve gives up with kCancelled soon after this turns true
+  /// (it is read before the assembly, after the factorization and at each step of the block Lanczos), for
+  /// work whose answer may no longer be wanted (the geometry correction's speculative modes, io/database).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// The first `modes` non-rigid modes of the free body, K φ = λ M φ, by shift-invert Lanczos (Spectra)
@@ -104,8 +109,8 @@ Result<core::ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOp
 /// (Lanczos stops at a relative residual of 1e-4, computeModes at 1e-10; on the default catalog's entries
 /// the frequencies agree to ~1e-8 and the shapes, where the next frequency is over 1 % away, to ~1e-7),
 /// in less time. `solves`, when given, receives the number of solves with the factorized K − σM (one per
-/// vector of a block). Errors: computeModes', and
-/// kInvalidArgument for seeds of the wrong size or not finite.
+/// vector of a block). Errors: computeModes', kInvalidArgument for seeds of the wrong size or not finite,
+/// and kCancelled once options.cancel is true.
 Result<core::ModalData> computeModesFrom(const core::TetMesh& mesh, const Eigen::MatrixXd& seeds,
                                          const ModalOptions& options, int* solves = nullptr);
 
