@@ -122,6 +122,7 @@ nlohmann::json correctionJson(const volume::CorrectionReport& c) {
           {"mass_spread", c.massSpread},
           {"morphs", c.morphs},
           {"fallback", c.fallback},
+          {"speculative", c.speculative},
           {"solves", c.solves},
           {"morph_seconds", c.morphSeconds},
           {"modes_seconds", c.modesSeconds}};

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -7,12 +8,15 @@
 #include <functional>
 #include <list>
 #include <mutex>
+#include <optional>
+#include <span>
 #include <string_view>
 #include <unordered_map>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <shapedb/core/error_model.h>
 #include <shapedb/core/mass_properties.h>
@@ -70,6 +74,18 @@ struct Correction {
   std::string error;                 ///< the first failure's, when nothing was corrected
 };
 
+/// The morph a correction answers with among those of `morphs` that are `done` and did not fail: the best
+/// by volume::betterMorph, the better rank among equals.
+std::optional<std::size_t> bestMorph(std::span<const std::optional<Result<volume::MorphedEntry>>> morphs,
+                                     std::span<const char> done) {
+  std::optional<std::size_t> best;
+  for (std::size_t i = 0; i < morphs.size(); ++i)
+    if (done[i] && *morphs[i] &&
+        (!best || volume::betterMorph((*morphs[i])->report, (*morphs[*best])->report)))
+      best = i;
+  return best;
+}
+
 /// Morphs the entries of `q`'s first `candidates` matches (`entries`, in match order) onto `mesh`, each
 /// carried into its entry's canonical frame, and computes the modes of the morph that reaches `mesh`'s
 /// surface best (the smallest mean target distance; the first of equals) among those whose tets do not
@@ -77,6 +93,12 @@ struct Correction {
 /// are passed over. Where the chosen morph leaves much of `mesh` unfilled (volume::kMassScaleWarning),
 /// `fallback` (if given) is asked for more entries: the best of their morphs that draw no warning answers
 /// instead.
+///
+/// The morphs run at once, each its own task. A core that has finished its morph while the last one is
+/// still running on another would wait for it; it computes the modes of the best morph so far instead, on
+/// the guess that the last will not beat it (it is one of three, as a rule). Where it does, the guess is
+/// cancelled and the modes computed for the morph chosen, as without the guess. The answer is the same
+/// either way, to the bit: the guess's modes are only kept where they are the chosen morph's.
 Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryResult& q,
                                   std::span<const std::shared_ptr<const CachedEntry>> entries,
                                   std::size_t candidates, const volume::ModalOptions& modal,
@@ -96,65 +118,127 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     return out;
   }
   double morphSeconds = 1e-6 * microsecondsSince(start);
-  // The candidates' morphs at once (each its own task: on a free core, the correction waits for the
-  // slowest morph rather than for all of them), then chosen in rank order, the better rank among equals.
+
+  // The chosen morph's missing mass placed (and the time that took), then its modes.
+  struct Corrected {
+    Result<volume::CorrectedEntry> entry;
+    double placingSeconds = 0.0;
+  };
+  const auto correct = [&](volume::MorphedEntry morphed, const core::PhysicalData& entry,
+                           const core::Mat3& orientation, const volume::ModalOptions& solve) {
+    const Clock::time_point placing = Clock::now();
+    volume::placeMissingMass(morphed, volume::MorphTarget::View(*target, orientation));
+    const double placed = 1e-6 * microsecondsSince(placing);
+    return Corrected{volume::correctMorphed(entry, std::move(morphed), solve), placed};
+  };
+
   std::vector<std::optional<Result<volume::MorphedEntry>>> morphs(candidates);
-  tbb::parallel_for(std::size_t{0}, candidates, [&](std::size_t i) {
-    const volume::MorphTarget::View view(*target, q.matches[i].match.orientation);
-    morphs[i] = volume::morphEntry(entries[i]->data, view, options, volume::MissingMass::kDeferred);
-  });
-  std::optional<volume::MorphedEntry> chosen;
-  std::size_t fallbacksMorphed = 0;
-  for (std::size_t i = 0; i < candidates; ++i) {
-    Result<volume::MorphedEntry>& m = *morphs[i];
-    if (!m) {
-      if (out.error.empty()) out.error = m.error().message;
-      continue;
+  std::mutex progress;  // guards the morphs' progress and the guess, down to speculationStands
+  std::vector<char> done(candidates, 0);
+  std::size_t started = 0, ended = 0;
+  std::optional<std::size_t> speculated;  // the morph whose modes are computed on the guess
+  bool speculationStands = false;         // ... and it is the one chosen
+  std::atomic<bool> cancel{false};
+  std::optional<Corrected> speculative;
+
+  // Once every candidate is morphed: the choice, the fallback, the modes (the guess's if it stands).
+  const auto conclude = [&] {
+    for (std::size_t i = 0; i < candidates; ++i) {
+      const Result<volume::MorphedEntry>& m = *morphs[i];
+      if (m)
+        morphSeconds += m->report.morphSeconds;
+      else if (out.error.empty())
+        out.error = m.error().message;
     }
-    morphSeconds += m->report.morphSeconds;
-    if (!chosen || volume::betterMorph(m->report, chosen->report)) {
-      chosen = std::move(m).value();
-      out.answered = i;
-    }
-  }
-  if (chosen && chosen->report.massScale > volume::kMassScaleWarning && fallback) {
-    // The fallback entries' morphs at once; the best of those that draw no warning answers instead.
-    std::vector<Fallback> more = fallback();
-    fallbacksMorphed = more.size();
-    std::vector<std::optional<Result<volume::MorphedEntry>>> extra(more.size());
-    tbb::parallel_for(std::size_t{0}, more.size(), [&](std::size_t i) {
-      extra[i] = volume::morphEntry(more[i].entry->data,
-                                    volume::MorphTarget::View(*target, more[i].match.orientation), options,
-                                    volume::MissingMass::kDeferred);
-    });
-    for (std::size_t i = 0; i < more.size(); ++i) {
-      Result<volume::MorphedEntry>& m = *extra[i];
-      if (!m) continue;
-      morphSeconds += m->report.morphSeconds;
-      if (!volume::correctionWarnings(m->report).empty()) continue;
-      if (!out.fallback || volume::betterMorph(m->report, chosen->report)) {
-        chosen = std::move(m).value();
-        out.fallback = std::move(more[i]);
+    const std::optional<std::size_t> best = bestMorph(morphs, done);
+    if (!best) return;
+    out.answered = *best;
+    std::size_t fallbacksMorphed = 0;
+    std::optional<Corrected> c;
+    if (speculationStands) {
+      c = std::move(speculative);
+    } else {
+      volume::MorphedEntry chosen = std::move(*morphs[*best]).value();
+      if (chosen.report.massScale > volume::kMassScaleWarning && fallback) {
+        // The fallback entries' morphs at once; the best of those that draw no warning answers instead.
+        std::vector<Fallback> more = fallback();
+        fallbacksMorphed = more.size();
+        std::vector<std::optional<Result<volume::MorphedEntry>>> extra(more.size());
+        tbb::parallel_for(std::size_t{0}, more.size(), [&](std::size_t i) {
+          extra[i] = volume::morphEntry(more[i].entry->data,
+                                        volume::MorphTarget::View(*target, more[i].match.orientation),
+                                        options, volume::MissingMass::kDeferred);
+        });
+        for (std::size_t i = 0; i < more.size(); ++i) {
+          Result<volume::MorphedEntry>& m = *extra[i];
+          if (!m) continue;
+          morphSeconds += m->report.morphSeconds;
+          if (!volume::correctionWarnings(m->report).empty()) continue;
+          if (!out.fallback || volume::betterMorph(m->report, chosen.report)) {
+            chosen = std::move(m).value();
+            out.fallback = std::move(more[i]);
+          }
+        }
       }
+      const core::Mat3& orientation =
+          out.fallback ? out.fallback->match.orientation : q.matches[out.answered].match.orientation;
+      const core::PhysicalData& entry =
+          out.fallback ? out.fallback->entry->data : entries[out.answered]->data;
+      c = correct(std::move(chosen), entry, orientation, modal);
     }
-  }
-  if (!chosen) return out;
-  const core::Mat3& orientation =
-      out.fallback ? out.fallback->match.orientation : q.matches[out.answered].match.orientation;
-  const core::PhysicalData& entry = out.fallback ? out.fallback->entry->data : entries[out.answered]->data;
-  const Clock::time_point placing = Clock::now();
-  volume::placeMissingMass(*chosen, volume::MorphTarget::View(*target, orientation));
-  chosen->report.morphs = static_cast<int>(candidates + fallbacksMorphed);
-  chosen->report.fallback = out.fallback.has_value();
-  chosen->report.morphSeconds = morphSeconds + 1e-6 * microsecondsSince(placing);
-  auto c = volume::correctMorphed(entry, std::move(*chosen), modal);
-  if (!c) {
-    out.error = c.error().message;
-    out.answered = 0;
-    out.fallback.reset();
-    return out;
-  }
-  out.corrected = std::move(c).value();
+    if (!c->entry) {
+      out.error = c->entry.error().message;
+      out.answered = 0;
+      out.fallback.reset();
+      return;
+    }
+    out.corrected = std::move(c->entry).value();
+    volume::CorrectionReport& report = out.corrected->report;
+    report.morphs = static_cast<int>(candidates + fallbacksMorphed);
+    report.fallback = out.fallback.has_value();
+    report.morphSeconds = morphSeconds + c->placingSeconds;
+    report.speculative = speculationStands;
+  };
+
+  tbb::task_group group;
+  for (std::size_t i = 0; i < candidates; ++i)
+    group.run([&, i] {
+      {
+        const std::lock_guard lock(progress);
+        ++started;
+      }
+      morphs[i] = volume::morphEntry(entries[i]->data,
+                                     volume::MorphTarget::View(*target, q.matches[i].match.orientation),
+                                     options, volume::MissingMass::kDeferred);
+      std::optional<volume::MorphedEntry> guess;
+      bool last = false;
+      {
+        const std::lock_guard lock(progress);
+        done[i] = 1;
+        last = ++ended == candidates;
+        if (last && speculated) {
+          speculationStands = bestMorph(morphs, done) == speculated;
+          if (!speculationStands) cancel = true;
+        } else if (!last && ended + 1 == candidates && started == candidates) {
+          // The one morph left is running elsewhere. The guess is only made where the best so far, if it
+          // stays the best, is what answers: not where it would send the correction to its fallback.
+          const std::optional<std::size_t> best = bestMorph(morphs, done);
+          if (best && !(fallback && (*morphs[*best])->report.massScale > volume::kMassScaleWarning)) {
+            speculated = best;
+            guess = (*morphs[*best]).value();
+          }
+        }
+      }
+      if (guess) {
+        volume::ModalOptions cancellable = modal;
+        cancellable.cancel = &cancel;
+        speculative = correct(std::move(*guess), entries[*speculated]->data,
+                              q.matches[*speculated].match.orientation, cancellable);
+      }
+      if (last && !speculationStands) conclude();
+    });
+  group.wait();
+  if (speculationStands) conclude();
   return out;
 }
 
