@@ -96,6 +96,23 @@ volume::ShapeSpec entrySpec(const EntryRecord& e) {
 }
 
 /// Every entry's own surface, each under a random similarity (scale 0.5 to 2), in entry order.
+// Entry e's own surface stretched by `stretch`: a query that its entry's tets are morphed onto.
+core::TriangleMesh stretchedSurface(const Database& db, const EntryRecord& e, const core::Mat3& stretch) {
+  core::TriangleMesh surface = *volume::makeFamilyShape(entrySpec(e), db.parameters().resolution);
+  for (core::Vec3& v : surface.vertices)
+    v = stretch * v;
+  return surface;
+}
+
+// A corrected query that chooses among three candidates' morphs, without fidelity reports.
+QueryOptions correctedAmongThree() {
+  QueryOptions options;
+  options.fidelity = false;
+  options.correct = true;
+  options.correctionCandidates = 3;
+  return options;
+}
+
 std::vector<core::TriangleMesh> ownSurfacesUnderSimilarities(const Database& db, std::mt19937_64& rng) {
   std::vector<core::TriangleMesh> surfaces;
   for (const EntryRecord& e : db.entries())
@@ -504,14 +521,8 @@ TEST_F(SmallDatabase, TheCorrectionAnswersWithTheCandidateWhoseMorphReachesTheQu
   std::size_t checked = 0;
   for (std::size_t n = 0; n < db->entries().size(); n += 8) {
     const EntryRecord& e = db->entries()[n];
-    const volume::ShapeSpec spec = entrySpec(e);
-    core::TriangleMesh query = *volume::makeFamilyShape(spec, db->parameters().resolution);
-    for (core::Vec3& v : query.vertices)
-      v = stretch * v;
-    QueryOptions options;
-    options.fidelity = false;
-    options.correct = true;
-    options.correctionCandidates = 3;
+    const core::TriangleMesh query = stretchedSurface(*db, e, stretch);
+    QueryOptions options = correctedAmongThree();
     options.correctionFallback = false;  // the candidates alone: the fallback has its own test
     auto r = db->query(query, options);
     ASSERT_TRUE(r.ok() && r->physics) << e.name << ": " << (r ? "" : r.error().message);
@@ -586,13 +597,8 @@ TEST_F(SmallDatabase, TheCorrectionsGuessOnAWaitingCoreChangesNoAnswer) {
   std::size_t corrected = 0, guessed = 0;
   for (std::size_t n = 0; n < db->entries().size(); n += 2) {
     const EntryRecord& e = db->entries()[n];
-    core::TriangleMesh query = *volume::makeFamilyShape(entrySpec(e), db->parameters().resolution);
-    for (core::Vec3& v : query.vertices)
-      v = stretch * v;
-    QueryOptions options;
-    options.fidelity = false;
-    options.correct = true;
-    options.correctionCandidates = 3;
+    const core::TriangleMesh query = stretchedSurface(*db, e, stretch);
+    const QueryOptions options = correctedAmongThree();
     std::optional<Result<QueryResult>> alone;
     one.execute([&] { alone.emplace(db->query(query, options)); });
     auto shared = db->query(query, options);
