@@ -74,16 +74,72 @@ struct Correction {
   std::string error;                 ///< the first failure's, when nothing was corrected
 };
 
+/// Morphs of a correction, by index, each set once its task has ended.
+using Morphs = std::vector<std::optional<Result<volume::MorphedEntry>>>;
+
 /// The morph a correction answers with among those of `morphs` that are `done` and did not fail: the best
 /// by volume::betterMorph, the better rank among equals.
-std::optional<std::size_t> bestMorph(std::span<const std::optional<Result<volume::MorphedEntry>>> morphs,
-                                     std::span<const char> done) {
+std::optional<std::size_t> bestMorph(const Morphs& morphs, std::span<const char> done) {
   std::optional<std::size_t> best;
   for (std::size_t i = 0; i < morphs.size(); ++i)
     if (done[i] && *morphs[i] &&
         (!best || volume::betterMorph((*morphs[i])->report, (*morphs[*best])->report)))
       best = i;
   return best;
+}
+
+/// The chosen morph's correction: its missing mass placed (and the time that took), then its modes.
+struct Corrected {
+  Result<volume::CorrectedEntry> entry;
+  double placingSeconds = 0.0;
+};
+
+/// Runs `morph(i)` for every i < count at once, one task each, with a guess on a core that would otherwise
+/// wait: once all but one have ended and the last is running on another thread, `pick(done)` names the
+/// morph whose correction would answer were the last not to change the choice (none: no guess), `copy(k)`
+/// copies it (both under the race's lock), and `guess(k, copy, cancel)` computes that correction on this
+/// thread. Once all have ended, `conclude` is called once: where `pick` over all of them names the guessed
+/// morph again, with the guess's correction, after the guess has ended; else with none, at once, on the
+/// last morph's thread, the guess (if any) cancelled through `cancel`.
+template <class Morph, class Pick, class Copy, class Guess, class Conclude>
+void morphAtOnce(std::size_t count, const Morph& morph, const Pick& pick, const Copy& copy,
+                 const Guess& guess, const Conclude& conclude) {
+  if (count == 0) return conclude(std::optional<Corrected>());
+  std::mutex progress;  // guards all that follows but the cancel flag and the guess's correction
+  std::vector<char> done(count, 0);
+  std::size_t started = 0, ended = 0;
+  std::optional<std::size_t> guessed;
+  bool stands = false;
+  std::atomic<bool> cancel{false};
+  std::optional<Corrected> correction;  // the guess's, written by its task alone
+  tbb::task_group group;
+  for (std::size_t i = 0; i < count; ++i)
+    group.run([&, i] {
+      {
+        const std::lock_guard lock(progress);
+        ++started;
+      }
+      morph(i);
+      std::optional<volume::MorphedEntry> taken;
+      bool last = false;
+      {
+        const std::lock_guard lock(progress);
+        done[i] = 1;
+        last = ++ended == count;
+        if (last && guessed) {
+          stands = pick(std::span<const char>(done)) == guessed;
+          if (!stands) cancel = true;
+        } else if (!last && ended + 1 == count && started == count) {
+          // The one morph left is running on another thread.
+          guessed = pick(std::span<const char>(done));
+          if (guessed) taken = copy(*guessed);
+        }
+      }
+      if (taken) correction = guess(*guessed, std::move(*taken), &cancel);
+      if (last && !stands) conclude(std::optional<Corrected>());
+    });
+  group.wait();
+  if (stands) conclude(std::move(correction));
 }
 
 /// Morphs the entries of `q`'s first `candidates` matches (`entries`, in match order) onto `mesh`, each
@@ -94,11 +150,12 @@ std::optional<std::size_t> bestMorph(std::span<const std::optional<Result<volume
 /// `fallback` (if given) is asked for more entries: the best of their morphs that draw no warning answers
 /// instead.
 ///
-/// The morphs run at once, each its own task. A core that has finished its morph while the last one is
-/// still running on another would wait for it; it computes the modes of the best morph so far instead, on
-/// the guess that the last will not beat it (it is one of three, as a rule). Where it does, the guess is
-/// cancelled and the modes computed for the morph chosen, as without the guess. The answer is the same
-/// either way, to the bit: the guess's modes are only kept where they are the chosen morph's.
+/// The morphs run at once, each its own task, the fallback's after the candidates'. A core that has
+/// finished its morph while the last one is still running on another would wait for it; it computes the
+/// modes of what would answer if the last did not change the choice instead (morphAtOnce), on the guess
+/// that it will not (the last is one of three or four, as a rule). Where it does, the guess is cancelled
+/// and the modes computed for the morph chosen, as without the guess. The answer is the same either way,
+/// to the bit: the guess's modes are kept only where they are the chosen morph's.
 Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryResult& q,
                                   std::span<const std::shared_ptr<const CachedEntry>> entries,
                                   std::size_t candidates, const volume::ModalOptions& modal,
@@ -119,126 +176,121 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
   }
   double morphSeconds = 1e-6 * microsecondsSince(start);
 
-  // The chosen morph's missing mass placed (and the time that took), then its modes.
-  struct Corrected {
-    Result<volume::CorrectedEntry> entry;
-    double placingSeconds = 0.0;
-  };
   const auto correct = [&](volume::MorphedEntry morphed, const core::PhysicalData& entry,
-                           const core::Mat3& orientation, const volume::ModalOptions& solve) {
+                           const core::Mat3& orientation, const std::atomic<bool>* cancel) {
     const Clock::time_point placing = Clock::now();
     volume::placeMissingMass(morphed, volume::MorphTarget::View(*target, orientation));
     const double placed = 1e-6 * microsecondsSince(placing);
+    volume::ModalOptions solve = modal;
+    solve.cancel = cancel;
     return Corrected{volume::correctMorphed(entry, std::move(morphed), solve), placed};
   };
-
-  std::vector<std::optional<Result<volume::MorphedEntry>>> morphs(candidates);
-  std::mutex progress;  // guards the morphs' progress and the guess, down to speculationStands
-  std::vector<char> done(candidates, 0);
-  std::size_t started = 0, ended = 0;
-  std::optional<std::size_t> speculated;  // the morph whose modes are computed on the guess
-  bool speculationStands = false;         // ... and it is the one chosen
-  std::atomic<bool> cancel{false};
-  std::optional<Corrected> speculative;
-
-  // Once every candidate is morphed: the choice, the fallback, the modes (the guess's if it stands).
-  const auto conclude = [&] {
-    for (std::size_t i = 0; i < candidates; ++i) {
-      const Result<volume::MorphedEntry>& m = *morphs[i];
-      if (m)
-        morphSeconds += m->report.morphSeconds;
-      else if (out.error.empty())
-        out.error = m.error().message;
-    }
-    const std::optional<std::size_t> best = bestMorph(morphs, done);
-    if (!best) return;
-    out.answered = *best;
-    std::size_t fallbacksMorphed = 0;
-    std::optional<Corrected> c;
-    if (speculationStands) {
-      c = std::move(speculative);
-    } else {
-      volume::MorphedEntry chosen = std::move(*morphs[*best]).value();
-      if (chosen.report.massScale > volume::kMassScaleWarning && fallback) {
-        // The fallback entries' morphs at once; the best of those that draw no warning answers instead.
-        std::vector<Fallback> more = fallback();
-        fallbacksMorphed = more.size();
-        std::vector<std::optional<Result<volume::MorphedEntry>>> extra(more.size());
-        tbb::parallel_for(std::size_t{0}, more.size(), [&](std::size_t i) {
-          extra[i] = volume::morphEntry(more[i].entry->data,
-                                        volume::MorphTarget::View(*target, more[i].match.orientation),
-                                        options, volume::MissingMass::kDeferred);
-        });
-        for (std::size_t i = 0; i < more.size(); ++i) {
-          Result<volume::MorphedEntry>& m = *extra[i];
-          if (!m) continue;
-          morphSeconds += m->report.morphSeconds;
-          if (!volume::correctionWarnings(m->report).empty()) continue;
-          if (!out.fallback || volume::betterMorph(m->report, chosen.report)) {
-            chosen = std::move(m).value();
-            out.fallback = std::move(more[i]);
-          }
-        }
-      }
-      const core::Mat3& orientation =
-          out.fallback ? out.fallback->match.orientation : q.matches[out.answered].match.orientation;
-      const core::PhysicalData& entry =
-          out.fallback ? out.fallback->entry->data : entries[out.answered]->data;
-      c = correct(std::move(chosen), entry, orientation, modal);
-    }
-    if (!c->entry) {
-      out.error = c->entry.error().message;
-      out.answered = 0;
-      out.fallback.reset();
-      return;
-    }
-    out.corrected = std::move(c->entry).value();
-    volume::CorrectionReport& report = out.corrected->report;
-    report.morphs = static_cast<int>(candidates + fallbacksMorphed);
-    report.fallback = out.fallback.has_value();
-    report.morphSeconds = morphSeconds + c->placingSeconds;
-    report.speculative = speculationStands;
+  const auto morphInto = [&](Morphs& into, const core::PhysicalData& entry, const core::Mat3& orientation,
+                             std::size_t i) {
+    into[i] = volume::morphEntry(entry, volume::MorphTarget::View(*target, orientation), options,
+                                 volume::MissingMass::kDeferred);
+  };
+  const auto sendsToFallback = [&](const volume::MorphedEntry& m) {
+    return fallback && m.report.massScale > volume::kMassScaleWarning;
   };
 
-  tbb::task_group group;
-  for (std::size_t i = 0; i < candidates; ++i)
-    group.run([&, i] {
-      {
-        const std::lock_guard lock(progress);
-        ++started;
-      }
-      morphs[i] = volume::morphEntry(entries[i]->data,
-                                     volume::MorphTarget::View(*target, q.matches[i].match.orientation),
-                                     options, volume::MissingMass::kDeferred);
-      std::optional<volume::MorphedEntry> guess;
-      bool last = false;
-      {
-        const std::lock_guard lock(progress);
-        done[i] = 1;
-        last = ++ended == candidates;
-        if (last && speculated) {
-          speculationStands = bestMorph(morphs, done) == speculated;
-          if (!speculationStands) cancel = true;
-        } else if (!last && ended + 1 == candidates && started == candidates) {
-          // The one morph left is running elsewhere. The guess is only made where the best so far, if it
-          // stays the best, is what answers: not where it would send the correction to its fallback.
-          const std::optional<std::size_t> best = bestMorph(morphs, done);
-          if (best && !(fallback && (*morphs[*best])->report.massScale > volume::kMassScaleWarning)) {
-            speculated = best;
-            guess = (*morphs[*best]).value();
+  Morphs morphs(candidates);
+  std::optional<Corrected> c;  // the answer's correction
+  std::size_t fallbacksMorphed = 0;
+  bool guessed = false;
+
+  // The fallback entries' morphs at once, after the candidates' best, `chosen`, left the query unfilled:
+  // the best of those that draw no warning answers instead, if any does.
+  const auto correctWithFallback = [&](volume::MorphedEntry chosen) {
+    std::vector<Fallback> more = fallback();
+    fallbacksMorphed = more.size();
+    Morphs extra(more.size());
+    const std::size_t theCandidate = more.size();
+    const auto pick = [&](std::span<const char> done) -> std::optional<std::size_t> {
+      std::optional<std::size_t> best;
+      for (std::size_t i = 0; i < extra.size(); ++i)
+        if (done[i] && *extra[i] && volume::correctionWarnings((*extra[i])->report).empty() &&
+            (!best || volume::betterMorph((*extra[i])->report, (*extra[*best])->report)))
+          best = i;
+      return best.value_or(theCandidate);
+    };
+    const auto entryOf = [&](std::size_t k) -> const core::PhysicalData& {
+      return k == theCandidate ? entries[out.answered]->data : more[k].entry->data;
+    };
+    const auto orientationOf = [&](std::size_t k) -> const core::Mat3& {
+      return k == theCandidate ? q.matches[out.answered].match.orientation : more[k].match.orientation;
+    };
+    morphAtOnce(
+        more.size(), [&](std::size_t i) { morphInto(extra, entryOf(i), orientationOf(i), i); }, pick,
+        [&](std::size_t k) { return k == theCandidate ? chosen : (*extra[k]).value(); },
+        [&](std::size_t k, volume::MorphedEntry m, const std::atomic<bool>* cancel) {
+          return correct(std::move(m), entryOf(k), orientationOf(k), cancel);
+        },
+        [&](std::optional<Corrected> guess) {
+          for (const auto& m : extra)
+            if (*m) morphSeconds += (*m)->report.morphSeconds;
+          const std::vector<char> all(extra.size(), 1);
+          const std::size_t k = *pick(all);              // never empty: the candidate at least
+          const core::PhysicalData& entry = entryOf(k);  // kept alive by out.fallback's entry below
+          const core::Mat3 orientation = orientationOf(k);
+          if (k != theCandidate) {
+            chosen = std::move(*extra[k]).value();
+            out.fallback = std::move(more[k]);
           }
+          guessed = guess.has_value();
+          c = guess ? std::move(guess) : correct(std::move(chosen), entry, orientation, nullptr);
+        });
+  };
+
+  morphAtOnce(
+      candidates,
+      [&](std::size_t i) { morphInto(morphs, entries[i]->data, q.matches[i].match.orientation, i); },
+      // No guess where the best so far, if it stays the best, sends the correction to its fallback.
+      [&](std::span<const char> done) -> std::optional<std::size_t> {
+        const std::optional<std::size_t> best = bestMorph(morphs, done);
+        return best && !sendsToFallback((*morphs[*best]).value()) ? best : std::nullopt;
+      },
+      [&](std::size_t k) { return (*morphs[k]).value(); },
+      [&](std::size_t k, volume::MorphedEntry m, const std::atomic<bool>* cancel) {
+        return correct(std::move(m), entries[k]->data, q.matches[k].match.orientation, cancel);
+      },
+      [&](std::optional<Corrected> guess) {
+        for (std::size_t i = 0; i < candidates; ++i) {
+          const Result<volume::MorphedEntry>& m = *morphs[i];
+          if (m)
+            morphSeconds += m->report.morphSeconds;
+          else if (out.error.empty())
+            out.error = m.error().message;
         }
-      }
-      if (guess) {
-        volume::ModalOptions cancellable = modal;
-        cancellable.cancel = &cancel;
-        speculative = correct(std::move(*guess), entries[*speculated]->data,
-                              q.matches[*speculated].match.orientation, cancellable);
-      }
-      if (last && !speculationStands) conclude();
-    });
-  group.wait();
-  if (speculationStands) conclude();
+        const std::vector<char> all(candidates, 1);
+        const std::optional<std::size_t> best = bestMorph(morphs, all);
+        if (!best) return;
+        out.answered = *best;
+        if (guess) {
+          guessed = true;
+          c = std::move(guess);
+          return;
+        }
+        volume::MorphedEntry chosen = std::move(*morphs[*best]).value();
+        if (sendsToFallback(chosen))
+          correctWithFallback(std::move(chosen));
+        else
+          c = correct(std::move(chosen), entries[*best]->data, q.matches[*best].match.orientation, nullptr);
+      });
+
+  if (!c) return out;
+  if (!c->entry) {
+    out.error = c->entry.error().message;
+    out.answered = 0;
+    out.fallback.reset();
+    return out;
+  }
+  out.corrected = std::move(c->entry).value();
+  volume::CorrectionReport& report = out.corrected->report;
+  report.morphs = static_cast<int>(candidates + fallbacksMorphed);
+  report.fallback = out.fallback.has_value();
+  report.morphSeconds = morphSeconds + c->placingSeconds;
+  report.speculative = guessed;
   return out;
 }
 

@@ -55,9 +55,9 @@ struct CorrectionReport {
   /// because the nearest matches' morphs left much of the query unfilled, not one of those matches;
   /// `morphs` counts them too.
   bool fallback = false;
-  /// The modes were computed on a guess, while the last of a query's candidates was still being morphed:
-  /// those of the best morph then, which stayed the best (io::Database::query). The same modes as after
-  /// the last morph, sooner.
+  /// The modes were computed on a guess, while the last of a query's candidates (or of its fallback
+  /// entries) was still being morphed: those of the morph that would answer then, which still did after
+  /// the last (io::Database::query). The same modes as after the last morph, sooner.
   bool speculative = false;
   double morphSeconds = 0.0;
   double modesSeconds = 0.0;
