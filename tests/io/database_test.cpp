@@ -95,7 +95,6 @@ volume::ShapeSpec entrySpec(const EntryRecord& e) {
                             static_cast<std::uint32_t>(std::stoul(e.name.substr(e.name.find('-') + 1))));
 }
 
-/// Every entry's own surface, each under a random similarity (scale 0.5 to 2), in entry order.
 // Entry e's own surface stretched by `stretch`: a query that its entry's tets are morphed onto.
 core::TriangleMesh stretchedSurface(const Database& db, const EntryRecord& e, const core::Mat3& stretch) {
   core::TriangleMesh surface = *volume::makeFamilyShape(entrySpec(e), db.parameters().resolution);
@@ -113,6 +112,7 @@ QueryOptions correctedAmongThree() {
   return options;
 }
 
+/// Every entry's own surface, each under a random similarity (scale 0.5 to 2), in entry order.
 std::vector<core::TriangleMesh> ownSurfacesUnderSimilarities(const Database& db, std::mt19937_64& rng) {
   std::vector<core::TriangleMesh> surfaces;
   for (const EntryRecord& e : db.entries())
