@@ -77,12 +77,14 @@ struct Correction {
 /// Morphs of a correction, by index, each set once its task has ended.
 using Morphs = std::vector<std::optional<Result<volume::MorphedEntry>>>;
 
-/// The morph a correction answers with among those of `morphs` that are `done` and did not fail: the best
-/// by volume::betterMorph, the better rank among equals.
-std::optional<std::size_t> bestMorph(const Morphs& morphs, std::span<const char> done) {
+/// The morph a correction answers with among those of `morphs` that are `done` and did not fail (and,
+/// with `warningFree`, draw no volume::correctionWarnings: the fallback's rule): the best by
+/// volume::betterMorph, the better rank among equals.
+std::optional<std::size_t> bestMorph(const Morphs& morphs, std::span<const char> done,
+                                     bool warningFree = false) {
   std::optional<std::size_t> best;
   for (std::size_t i = 0; i < morphs.size(); ++i)
-    if (done[i] && *morphs[i] &&
+    if (done[i] && *morphs[i] && (!warningFree || volume::correctionWarnings((*morphs[i])->report).empty()) &&
         (!best || volume::betterMorph((*morphs[i])->report, (*morphs[*best])->report)))
       best = i;
   return best;
@@ -207,12 +209,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     Morphs extra(more.size());
     const std::size_t theCandidate = more.size();
     const auto pick = [&](std::span<const char> done) -> std::optional<std::size_t> {
-      std::optional<std::size_t> best;
-      for (std::size_t i = 0; i < extra.size(); ++i)
-        if (done[i] && *extra[i] && volume::correctionWarnings((*extra[i])->report).empty() &&
-            (!best || volume::betterMorph((*extra[i])->report, (*extra[*best])->report)))
-          best = i;
-      return best.value_or(theCandidate);
+      return bestMorph(extra, done, /*warningFree=*/true).value_or(theCandidate);
     };
     const auto entryOf = [&](std::size_t k) -> const core::PhysicalData& {
       return k == theCandidate ? entries[out.answered]->data : more[k].entry->data;
