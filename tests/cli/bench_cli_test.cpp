@@ -95,6 +95,24 @@ TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
     const double iou = std::stod(row[column["iou"]]);
     EXPECT_GT(iou, 0.2);
     EXPECT_LE(iou, 1.0);
+    // The corrected rows carry their morph's report; the others leave those columns empty.
+    const bool corrected = methods[i % m] == "centroid-voxel-corrected";
+    for (const char* name : {"worst_quality", "entry_worst_quality", "max_boundary_move",
+                             "mean_boundary_move", "projected", "prestretch"}) {
+      ASSERT_TRUE(column.count(name)) << name;
+      EXPECT_EQ(row[column[name]].empty(), !corrected) << name << " of " << methods[i % m];
+    }
+    if (corrected) {
+      const auto value = [&](const char* name) { return std::stod(row[column[name]]); };
+      EXPECT_GT(value("worst_quality"), 0.0);  // every morphed tet positive
+      EXPECT_LE(value("worst_quality"), 1.0);
+      EXPECT_GT(value("entry_worst_quality"), 0.0);
+      EXPECT_GE(value("max_boundary_move"), value("mean_boundary_move"));
+      EXPECT_GE(value("mean_boundary_move"), 0.0);
+      EXPECT_GE(value("projected"), 0.0);
+      EXPECT_LE(value("projected"), 1.0);
+      EXPECT_GE(value("prestretch"), 0.0);
+    }
     if (methods[i % m] != "ellipsoid" && methods[i % m] != "box") {  // the queries
       EXPECT_GT(std::stod(row[column["speedup"]]), 1.0);
     } else {

@@ -319,6 +319,13 @@ Result<std::vector<FragmentEvaluation>> evaluateShapes(const io::Database& datab
               m.strayShare = q.correction->strayShare;
               m.pointMassPeak = q.correction->pointMassPeak;
               m.lumpedModeShare = q.correction->lumpedModeShare;
+              const volume::MorphReport& morph = q.correction->morph;
+              m.worstQuality = morph.worstQuality;
+              m.entryWorstQuality = morph.entryWorstQuality;
+              m.maxBoundaryMove = morph.maxBoundaryMove;
+              m.meanBoundaryMove = morph.meanBoundaryMove;
+              m.projected = morph.projected;
+              m.prestretch = morph.stretch.array().log().abs().maxCoeff();
             }
             if (q.predictedFrequencyError) m.predictedError = *q.predictedFrequencyError;
             m.matchMicros = q.times.validate + q.times.massProperties + q.times.describe + q.times.search;
@@ -423,7 +430,8 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
       "shape,triangles,volume_m3,truth_tets,truth_s,method,match,family,distance,f1_hz,f1_truth_hz,"
       "f1_error,mean_error,max_error,frequencies,iou,coverage,overshoot,query_us,match_us,speedup,"
       "mean_deviation,max_deviation,max_moment_error,descriptor_distance,outside_share,"
-      "morph_target_distance,mass_scale,stray_share,point_mass_peak,lumped_mode_share,predicted_error,status";
+      "morph_target_distance,mass_scale,stray_share,point_mass_peak,lumped_mode_share,worst_quality,"
+      "entry_worst_quality,max_boundary_move,mean_boundary_move,projected,prestretch,predicted_error,status";
   // A shape that failed has its five shape columns, every method column empty, and its status.
   constexpr std::size_t kShapeColumns = 5;
   const std::string noMethod(
@@ -451,7 +459,10 @@ Status writeEvaluationCsv(std::span<const FragmentEvaluation> evaluations,
            << "," << number(m.descriptorDistance) << "," << number(m.outsideShare) << ","
            << number(m.morphTargetDistance) << "," << number(m.massScale) << "," << number(m.strayShare)
            << "," << number(m.pointMassPeak) << "," << number(m.lumpedModeShare) << ","
-           << number(m.predictedError) << "," << (e.ok() ? std::string("ok") : csvField(e.error)) << "\n";
+           << number(m.worstQuality) << "," << number(m.entryWorstQuality) << "," << number(m.maxBoundaryMove)
+           << "," << number(m.meanBoundaryMove) << "," << number(m.projected) << "," << number(m.prestretch)
+           << "," << number(m.predictedError) << "," << (e.ok() ? std::string("ok") : csvField(e.error))
+           << "\n";
     }
   }
   file.flush();

@@ -81,7 +81,12 @@ struct MethodEvaluation {
   double strayShare = kNaN;       ///< the corrected query: volume::CorrectionReport::strayShare
   double pointMassPeak = kNaN;    ///< the corrected query: volume::CorrectionReport::pointMassPeak
   double lumpedModeShare = kNaN;  ///< the corrected query: volume::CorrectionReport::lumpedModeShare
-  double predictedError = kNaN;   ///< descriptors: the query's QueryResult::predictedFrequencyError
+  /// The corrected query's morph (volume::MorphReport): the worst tet quality after it and before it, the
+  /// largest and mean move of a boundary node (relative to L), the share of the final projection taken,
+  /// and the prestretch's largest |ln| along an axis.
+  double worstQuality = kNaN, entryWorstQuality = kNaN, maxBoundaryMove = kNaN, meanBoundaryMove = kNaN;
+  double projected = kNaN, prestretch = kNaN;
+  double predictedError = kNaN;  ///< descriptors: the query's QueryResult::predictedFrequencyError
   double queryMicros = kNaN;  ///< descriptors: the whole query (match, fetch, correct, adapt, link), fidelity
                               ///< report aside
   double matchMicros = kNaN;  ///< descriptors: validate, mass properties, describe, search
