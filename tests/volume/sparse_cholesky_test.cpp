@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -136,6 +137,42 @@ TEST(SparseCholesky, TheFactorsHalvesComposeTheInverse) {
         Eigen::VectorXd x(a.rows());
         ASSERT_TRUE(cholesky.solveFactor(b.data(), x.data()));
         EXPECT_LT((x - ht * b).norm(), 1e-12 * x.norm()) << what;
+      }
+    }
+}
+
+TEST(SparseCholesky, FourColumnsSolveAsCholmodSolvesThem) {
+  // Four right-hand sides (the modal analysis's block) take a supernodal factor block by block without
+  // CHOLMOD's solve (BlockSolves::kAuto); CHOLMOD's own (kCholmod) is the oracle. Grids up to 8 × 8 × 8
+  // nodes give supernodes of hundreds of rows; a long bar, a long chain of small ones.
+  std::mt19937_64 rng(11);
+  for (const CholeskyMethod method : kMethods)
+    for (const auto& [side, length] : {std::pair{2, 0}, {5, 0}, {8, 0}, {3, 40}}) {
+      const Eigen::SparseMatrix<double> a = gridMatrix(side, rng, length);
+      const std::vector<int> order = shuffledOrder(a.rows(), rng);
+      for (const std::vector<int>& given : {std::vector<int>{}, order}) {
+        SparseCholesky own(method), cholmod(method);
+        cholmod.setBlockSolves(BlockSolves::kCholmod);
+        ASSERT_TRUE(own.factorize(a, given)) << "side " << side << ", " << name(method);
+        ASSERT_TRUE(cholmod.factorize(a, given)) << "side " << side << ", " << name(method);
+        ASSERT_LE(own.factorNonzeros(), kBlockSolvesMaxNonzeros);
+        const std::string what = "side " + std::to_string(side) + ", length " + std::to_string(length) +
+                                 ", " + (given.empty() ? "own" : "given") + " order, " + name(method);
+        const Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), 4);
+        Eigen::MatrixXd x(a.rows(), 4), xt(a.rows(), 4), expected(a.rows(), 4), expectedT(a.rows(), 4);
+        ASSERT_TRUE(own.solveFactor(b.data(), x.data(), 4));
+        ASSERT_TRUE(own.solveFactorTransposed(b.data(), xt.data(), 4));
+        ASSERT_TRUE(cholmod.solveFactor(b.data(), expected.data(), 4));
+        ASSERT_TRUE(cholmod.solveFactorTransposed(b.data(), expectedT.data(), 4));
+        EXPECT_LT((x - expected).norm(), 1e-12 * expected.norm()) << what;
+        EXPECT_LT((xt - expectedT).norm(), 1e-12 * expectedT.norm()) << what;
+        // The right-hand sides may be overwritten by their solution.
+        Eigen::MatrixXd inPlace = b;
+        ASSERT_TRUE(own.solveFactor(inPlace.data(), inPlace.data(), 4));
+        EXPECT_EQ(inPlace, x) << what;
+        inPlace = b;
+        ASSERT_TRUE(own.solveFactorTransposed(inPlace.data(), inPlace.data(), 4));
+        EXPECT_EQ(inPlace, xt) << what;
       }
     }
 }

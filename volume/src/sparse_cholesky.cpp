@@ -153,6 +153,8 @@ struct SparseCholesky::Impl {
   mutable cholmod_dense* x = nullptr;
   mutable cholmod_dense* y = nullptr;
   mutable cholmod_dense* e = nullptr;
+  /// The four-column solves' workspace (blockSolves): the right-hand sides row by row, one supernode's rows.
+  mutable std::vector<Eigen::Vector4d> rows, gathered;
 
   explicit Impl(CholeskyMethod method) {
     oneOpenBlasThread();
@@ -187,6 +189,85 @@ struct SparseCholesky::Impl {
       if (*d) cholmod_free_dense(d, &common);
   }
 };
+
+namespace {
+
+/// The supernodes of CHOLMOD's supernodal LLᵀ factor: supernode s is columns super[s] to super[s + 1] − 1,
+/// its rows s[pi[s]] to s[pi[s + 1] − 1] (its own columns first, the diagonal block's), its values the
+/// column-major block of those rows and columns at x + px[s].
+struct Supernodes {
+  explicit Supernodes(const cholmod_factor& f)
+      : count(f.nsuper),
+        super(static_cast<const int*>(f.super)),
+        pi(static_cast<const int*>(f.pi)),
+        px(static_cast<const int*>(f.px)),
+        rows(static_cast<const int*>(f.s)),
+        values(static_cast<const double*>(f.x)) {}
+  std::size_t count;
+  const int *super, *pi, *px, *rows;
+  const double* values;
+};
+
+/// L X = X for four right-hand sides, each row of X one Vector4d: supernode by supernode, the diagonal
+/// block's triangle solved, then its columns' part of the rows below subtracted (gathered in `below`, one
+/// pass over the block's values per column serving all four).
+void forwardSolve(const Supernodes& l, std::vector<Eigen::Vector4d>& x, std::vector<Eigen::Vector4d>& below) {
+  for (std::size_t s = 0; s < l.count; ++s) {
+    const int k1 = l.super[s], columns = l.super[s + 1] - k1, first = l.pi[s];
+    const int height = l.pi[s + 1] - first, offDiagonal = height - columns;
+    const double* block = l.values + l.px[s];
+    below.assign(static_cast<std::size_t>(offDiagonal), Eigen::Vector4d::Zero());
+    for (int j = 0; j < columns; ++j) {
+      const double* column = block + static_cast<std::ptrdiff_t>(j) * height;
+      Eigen::Vector4d& xj = x[static_cast<std::size_t>(k1 + j)];
+      xj /= column[j];
+      for (int i = j + 1; i < columns; ++i)
+        x[static_cast<std::size_t>(k1 + i)] -= column[i] * xj;
+      for (int i = 0; i < offDiagonal; ++i)
+        below[static_cast<std::size_t>(i)] += column[columns + i] * xj;
+    }
+    for (int i = 0; i < offDiagonal; ++i)
+      x[static_cast<std::size_t>(l.rows[first + columns + i])] -= below[static_cast<std::size_t>(i)];
+  }
+}
+
+/// Σ a[i] v[i] over `count` rows, in four interleaved partial sums: one sum's chain of additions would
+/// take an addition's latency per row.
+Eigen::Vector4d weightedSum(const double* a, const Eigen::Vector4d* v, int count) {
+  std::array<Eigen::Vector4d, 4> partial;
+  partial.fill(Eigen::Vector4d::Zero());
+  int i = 0;
+  for (; i + 4 <= count; i += 4)
+    for (int k = 0; k < 4; ++k)
+      partial[static_cast<std::size_t>(k)] += a[i + k] * v[i + k];
+  for (; i < count; ++i)
+    partial[0] += a[i] * v[i];
+  return (partial[0] + partial[1]) + (partial[2] + partial[3]);
+}
+
+/// Lᵀ X = X, the same way backwards: each supernode's rows below gathered once, then its columns solved
+/// last to first.
+void backwardSolve(const Supernodes& l, std::vector<Eigen::Vector4d>& x,
+                   std::vector<Eigen::Vector4d>& below) {
+  for (std::size_t s = l.count; s-- > 0;) {
+    const int k1 = l.super[s], columns = l.super[s + 1] - k1, first = l.pi[s];
+    const int height = l.pi[s + 1] - first, offDiagonal = height - columns;
+    const double* block = l.values + l.px[s];
+    below.resize(static_cast<std::size_t>(offDiagonal));
+    for (int i = 0; i < offDiagonal; ++i)
+      below[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(l.rows[first + columns + i])];
+    for (int j = columns - 1; j >= 0; --j) {
+      const double* column = block + static_cast<std::ptrdiff_t>(j) * height;
+      const Eigen::Vector4d sum =
+          weightedSum(column + columns, below.data(), offDiagonal) +
+          weightedSum(column + j + 1, &x[static_cast<std::size_t>(k1 + j + 1)], columns - j - 1);
+      Eigen::Vector4d& xj = x[static_cast<std::size_t>(k1 + j)];
+      xj = (xj - sum) / column[j];
+    }
+  }
+}
+
+}  // namespace
 
 SparseCholesky::SparseCholesky(CholeskyMethod method) : mImpl(std::make_unique<Impl>(method)) {}
 SparseCholesky::~SparseCholesky() = default;
@@ -288,12 +369,48 @@ bool SparseCholesky::solve(const double* b, double* x, Eigen::Index columns) con
 }
 
 bool SparseCholesky::solveFactor(const double* b, double* x, Eigen::Index columns) const {
+  if (blockSolves(columns)) {
+    // x = P b (row k of P b is row Perm[k] of b), then L⁻¹ x.
+    const Impl& s = *mImpl;
+    const int* perm = static_cast<const int*>(s.factor->Perm);
+    const std::size_t n = static_cast<std::size_t>(mRows);
+    s.rows.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int c = 0; c < 4; ++c)
+        s.rows[k][c] = b[static_cast<std::size_t>(c) * n + static_cast<std::size_t>(perm[k])];
+    forwardSolve(Supernodes(*s.factor), s.rows, s.gathered);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int c = 0; c < 4; ++c)
+        x[static_cast<std::size_t>(c) * n + k] = s.rows[k][c];
+    return true;
+  }
   // x = P b, then L⁻¹ x in place of it (CHOLMOD's P and L systems are separate calls).
   return solveSystem(CHOLMOD_P, b, x, columns) && solveSystem(CHOLMOD_L, x, x, columns);
 }
 
 bool SparseCholesky::solveFactorTransposed(const double* b, double* x, Eigen::Index columns) const {
+  if (blockSolves(columns)) {
+    // L⁻ᵀ b, then x = Pᵀ of it (row Perm[k] of x is row k).
+    const Impl& s = *mImpl;
+    const int* perm = static_cast<const int*>(s.factor->Perm);
+    const std::size_t n = static_cast<std::size_t>(mRows);
+    s.rows.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int c = 0; c < 4; ++c)
+        s.rows[k][c] = b[static_cast<std::size_t>(c) * n + k];
+    backwardSolve(Supernodes(*s.factor), s.rows, s.gathered);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int c = 0; c < 4; ++c)
+        x[static_cast<std::size_t>(c) * n + static_cast<std::size_t>(perm[k])] = s.rows[k][c];
+    return true;
+  }
   return solveSystem(CHOLMOD_Lt, b, x, columns) && solveSystem(CHOLMOD_Pt, x, x, columns);
+}
+
+bool SparseCholesky::blockSolves(Eigen::Index columns) const {
+  const cholmod_factor* f = mImpl->factor;
+  return mBlockSolves == BlockSolves::kAuto && columns == 4 && f && f->is_super && f->itype == CHOLMOD_INT &&
+         f->xtype == CHOLMOD_REAL && f->Perm && mFactorNonzeros <= kBlockSolvesMaxNonzeros;
 }
 
 bool SparseCholesky::supernodal() const {

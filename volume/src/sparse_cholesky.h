@@ -42,6 +42,24 @@ enum class CholeskyMethod { kAuto, kSimplicial, kSupernodal };
 /// column), 175.
 double supernodalSwitch();
 
+/// How solveFactor and solveFactorTransposed take four right-hand sides, the seeded modal analysis's block.
+/// kAuto: the supernodal factor block by block with loops of their own, where it has at most
+/// kBlockSolvesMaxNonzeros (CHOLMOD otherwise); kCholmod: always CHOLMOD's solve (the tests' oracle, and
+/// the factorization bench's comparison).
+///
+/// Why: with four columns CHOLMOD's supernodal solve hands each supernode to BLAS (dtrsm, dgemm), and
+/// OpenBLAS copies the supernode's block into its own layout on every call, a pass over the factor as long
+/// as the arithmetic's. The loops here read each block once, each row of the four right-hand sides one
+/// 4-vector: a solve's two halves took 0.6-0.8 times CHOLMOD's time on the default catalog's entries (up
+/// to 2.3 million nonzeros in the factor) and 1.0-1.2 times on larger ones, whose factor no longer fits in
+/// the processor's caches and which BLAS's blocking serves better (`factorization_bench`,
+/// bench/results/zen5-2core/block_solves_2026-11-30/).
+enum class BlockSolves { kAuto, kCholmod };
+
+/// The largest factor (CHOLMOD's lnz) whose four-column solves kAuto takes itself: measured between 2.3
+/// million (faster) and 2.5 million (as fast as CHOLMOD) nonzeros.
+inline constexpr double kBlockSolvesMaxNonzeros = 2.0e6;
+
 class SparseCholesky {
  public:
   explicit SparseCholesky(CholeskyMethod method = CholeskyMethod::kAuto);
@@ -70,9 +88,12 @@ class SparseCholesky {
   /// The factor's halves. CHOLMOD factorizes P A Pᵀ = L Lᵀ (P the fill-reducing permutation), so A⁻¹ = H Hᵀ
   /// with H = Pᵀ L⁻ᵀ: solveFactor gives X = Hᵀ B = L⁻¹ P B, solveFactorTransposed X = H B = Pᵀ L⁻ᵀ B, each
   /// half the work of a solve. What turns A⁻¹ M x = μ x into the symmetric Hᵀ M H y = μ y (x = H y).
-  /// Same contract as solve.
+  /// Same contract as solve; four columns may be solved without CHOLMOD (BlockSolves), to the same
+  /// values up to round-off.
   bool solveFactor(const double* b, double* x, Eigen::Index columns = 1) const;
   bool solveFactorTransposed(const double* b, double* x, Eigen::Index columns = 1) const;
+
+  void setBlockSolves(BlockSolves blockSolves) { mBlockSolves = blockSolves; }
 
   Eigen::Index rows() const { return mRows; }
   /// Why the last factorize or refactorize returned false (kNone after one that succeeded).
@@ -92,11 +113,15 @@ class SparseCholesky {
   /// NaN) if there is no factor or CHOLMOD could not allocate its scratch space, which it reuses from one
   /// call to the next. x may be b.
   bool solveSystem(int system, const double* b, double* x, Eigen::Index columns) const;
+  /// Whether solveFactor and solveFactorTransposed of `columns` right-hand sides take the supernodal
+  /// factor block by block themselves instead of CHOLMOD.
+  bool blockSolves(Eigen::Index columns) const;
   struct Impl;
   std::unique_ptr<Impl> mImpl;
   Eigen::Index mRows = 0;
   Failure mFailure = Failure::kNone;
   double mFactorNonzeros = 0.0;
+  BlockSolves mBlockSolves = BlockSolves::kAuto;
 };
 
 }  // namespace shapedb::volume::detail
