@@ -6,9 +6,12 @@
 // of each family: the degrees of freedom, each solver's factorization, one solve, one solve with 4
 // right-hand sides (CHOLMOD's: the seeded modal analysis's block) and one with 20 (milliseconds, best of
 // three), and how far the automatic choice's solution is from
-// Eigen's. Each factorization includes its analysis: Eigen's with its AMD on the scalar graph, CHOLMOD's
-// with the node-block order the modal analysis gives it. Run it on one core (taskset -c 0): the build
-// runs one factorization per core.
+// Eigen's. Then the factor's two halves (solveFactorTransposed, solveFactor: what a step of the seeded
+// modal analysis takes) for a block of 4 right-hand sides on the supernodal factor, by SparseCholesky's
+// own loops (BlockSolves::kAuto, where the factor is small enough for them) and by CHOLMOD's solve. Each
+// factorization includes its analysis: Eigen's with its AMD on the scalar graph, CHOLMOD's with the
+// node-block order the modal analysis gives it. Run it on one core (taskset -c 0): the build runs one
+// factorization per core.
 //   build/release/bin/factorization_bench DB [--per-family N]
 
 #include <algorithm>
@@ -65,9 +68,11 @@ int main(int argc, char** argv) {
       "| entry | dof | Eigen simplicial: factor | solve | 20 solves | CHOLMOD simplicial: factor | solve "
       "| 4 solves | 20 solves | CHOLMOD supernodal: factor | solve | 4 solves | 20 solves | automatic choice "
       "| "
-      "relative difference |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n");
+      "relative difference | factor nonzeros | 4-column halves: own | CHOLMOD |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|\n");
   std::map<std::string, int> taken;
   std::array<std::vector<double>, 2> blockRatio;  // over simplicial, over supernodal
+  std::vector<double> halvesRatio;                // own block solves over CHOLMOD's, where own are taken
   for (const io::EntryRecord& record : db->entries()) {
     if (taken[volume::toString(record.family)]++ >= perFamily) continue;
     auto physics = db->physics(record.id);
@@ -102,7 +107,22 @@ int main(int argc, char** argv) {
     automatic.factorize(a, order);
     const Eigen::MatrixXd xa = automatic.solve(b);
     const std::size_t chosen = automatic.supernodal() ? 1 : 0;
-    std::printf(" | %s | %.1e |\n", chosen ? "supernodal" : "simplicial", (x0 - xa).norm() / x0.norm());
+    std::printf(" | %s | %.1e", chosen ? "supernodal" : "simplicial", (x0 - xa).norm() / x0.norm());
+    volume::detail::SparseCholesky supernodal(volume::detail::CholeskyMethod::kSupernodal);
+    supernodal.factorize(a, order);
+    const Eigen::MatrixXd b4 = b.leftCols(4);
+    Eigen::MatrixXd h4(a.rows(), 4), y4(a.rows(), 4);
+    const auto halves = [&] {
+      supernodal.solveFactorTransposed(b4.data(), h4.data(), 4);
+      supernodal.solveFactor(h4.data(), y4.data(), 4);
+    };
+    const double own = bestOfThree(halves);
+    supernodal.setBlockSolves(volume::detail::BlockSolves::kCholmod);
+    const double cholmod = bestOfThree(halves);
+    const bool ownSolves = supernodal.factorNonzeros() <= volume::detail::kBlockSolvesMaxNonzeros;
+    std::printf(" | %.0f | %.3f%s | %.3f |\n", supernodal.factorNonzeros(), own,
+                ownSolves ? "" : " (CHOLMOD's)", cholmod);
+    if (ownSolves) halvesRatio.push_back(own / cholmod);
     // What the choice gains over either method alone for the modal analysis's use of a factorization: it
     // and ~64 solves.
     for (std::size_t k = 0; k < 2; ++k)
@@ -116,5 +136,9 @@ int main(int argc, char** argv) {
       "\nmedian speedup of the automatic choice on a factorization and 64 "
       "solves: %.2fx over the simplicial method alone, %.2fx over the supernodal one\n",
       median(blockRatio[0]), median(blockRatio[1]));
+  std::printf(
+      "median time of a 4-column solve's halves by SparseCholesky's own loops, over CHOLMOD's, where "
+      "they are taken: %.2f (%zu entries)\n",
+      median(halvesRatio), halvesRatio.size());
   return 0;
 }
