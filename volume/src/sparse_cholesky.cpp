@@ -370,18 +370,7 @@ bool SparseCholesky::solve(const double* b, double* x, Eigen::Index columns) con
 
 bool SparseCholesky::solveFactor(const double* b, double* x, Eigen::Index columns) const {
   if (blockSolves(columns)) {
-    // x = P b (row k of P b is row Perm[k] of b), then L⁻¹ x.
-    const Impl& s = *mImpl;
-    const int* perm = static_cast<const int*>(s.factor->Perm);
-    const std::size_t n = static_cast<std::size_t>(mRows);
-    s.rows.resize(n);
-    for (std::size_t k = 0; k < n; ++k)
-      for (int c = 0; c < 4; ++c)
-        s.rows[k][c] = b[static_cast<std::size_t>(c) * n + static_cast<std::size_t>(perm[k])];
-    forwardSolve(Supernodes(*s.factor), s.rows, s.gathered);
-    for (std::size_t k = 0; k < n; ++k)
-      for (int c = 0; c < 4; ++c)
-        x[static_cast<std::size_t>(c) * n + k] = s.rows[k][c];
+    solveFourColumns(/*transposed=*/false, b, x);
     return true;
   }
   // x = P b, then L⁻¹ x in place of it (CHOLMOD's P and L systems are separate calls).
@@ -390,21 +379,29 @@ bool SparseCholesky::solveFactor(const double* b, double* x, Eigen::Index column
 
 bool SparseCholesky::solveFactorTransposed(const double* b, double* x, Eigen::Index columns) const {
   if (blockSolves(columns)) {
-    // L⁻ᵀ b, then x = Pᵀ of it (row Perm[k] of x is row k).
-    const Impl& s = *mImpl;
-    const int* perm = static_cast<const int*>(s.factor->Perm);
-    const std::size_t n = static_cast<std::size_t>(mRows);
-    s.rows.resize(n);
-    for (std::size_t k = 0; k < n; ++k)
-      for (int c = 0; c < 4; ++c)
-        s.rows[k][c] = b[static_cast<std::size_t>(c) * n + k];
-    backwardSolve(Supernodes(*s.factor), s.rows, s.gathered);
-    for (std::size_t k = 0; k < n; ++k)
-      for (int c = 0; c < 4; ++c)
-        x[static_cast<std::size_t>(c) * n + static_cast<std::size_t>(perm[k])] = s.rows[k][c];
+    solveFourColumns(/*transposed=*/true, b, x);
     return true;
   }
   return solveSystem(CHOLMOD_Lt, b, x, columns) && solveSystem(CHOLMOD_Pt, x, x, columns);
+}
+
+void SparseCholesky::solveFourColumns(bool transposed, const double* b, double* x) const {
+  // L⁻¹ P b: row k of P b is row Perm[k] of b. Pᵀ L⁻ᵀ b: row Perm[k] of the result is row k of L⁻ᵀ b.
+  const Impl& s = *mImpl;
+  const int* perm = static_cast<const int*>(s.factor->Perm);
+  const std::size_t n = static_cast<std::size_t>(mRows);
+  const auto permuted = [perm](std::size_t k) { return static_cast<std::size_t>(perm[k]); };
+  s.rows.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t c = 0; c < 4; ++c)
+      s.rows[k][static_cast<Eigen::Index>(c)] = b[c * n + (transposed ? k : permuted(k))];
+  if (transposed)
+    backwardSolve(Supernodes(*s.factor), s.rows, s.gathered);
+  else
+    forwardSolve(Supernodes(*s.factor), s.rows, s.gathered);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t c = 0; c < 4; ++c)
+      x[c * n + (transposed ? permuted(k) : k)] = s.rows[k][static_cast<Eigen::Index>(c)];
 }
 
 bool SparseCholesky::blockSolves(Eigen::Index columns) const {

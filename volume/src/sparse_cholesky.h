@@ -116,6 +116,8 @@ class SparseCholesky {
   /// Whether solveFactor and solveFactorTransposed of `columns` right-hand sides take the supernodal
   /// factor block by block themselves instead of CHOLMOD.
   bool blockSolves(Eigen::Index columns) const;
+  /// solveFactor (or, `transposed`, solveFactorTransposed) of four columns, where blockSolves.
+  void solveFourColumns(bool transposed, const double* b, double* x) const;
   struct Impl;
   std::unique_ptr<Impl> mImpl;
   Eigen::Index mRows = 0;
