@@ -243,8 +243,8 @@ void forwardSolve(const Supernodes& l, std::vector<Eigen::Vector4d>& x, std::vec
       xj /= column[j];
       for (int i = j + 1; i < columns; ++i)
         x[static_cast<std::size_t>(k1 + i)] -= column[i] * xj;
-      for (int i = 0; i < offDiagonal; ++i)
-        below[static_cast<std::size_t>(i)] += column[columns + i] * xj;
+      for (int i = columns; i < height; ++i)
+        below[static_cast<std::size_t>(i - columns)] += column[i] * xj;
     }
     for (int i = 0; i < offDiagonal; ++i)
       x[static_cast<std::size_t>(l.rows[first + columns + i])] -= below[static_cast<std::size_t>(i)];

@@ -48,16 +48,17 @@ double supernodalSwitch();
 /// the factorization bench's comparison).
 ///
 /// Why: with four columns CHOLMOD's supernodal solve hands each supernode to BLAS (dtrsm, dgemm), and
-/// OpenBLAS copies the supernode's block into its own layout on every call, a pass over the factor as long
-/// as the arithmetic's. The loops here read each block once, each row of the four right-hand sides one
-/// 4-vector: a solve's two halves took 0.6-0.8 times CHOLMOD's time on the default catalog's entries (up
-/// to 2.3 million nonzeros in the factor) and 1.0-1.2 times on larger ones, whose factor no longer fits in
-/// the processor's caches and which BLAS's blocking serves better (`factorization_bench`,
-/// bench/results/zen5-2core/block_solves_2026-11-30/).
+/// OpenBLAS copies the supernode's block into its own layout on every call (about half the solves' time in
+/// a profile of the correction). The loops here read each block once, each row of the four right-hand
+/// sides one 4-vector: a solve's two halves took a median 0.57-0.58 of CHOLMOD's time (0.51-0.68) on the
+/// default catalog's entries of up to 2 million nonzeros in the factor, and 0.9-1.2 times on factors from
+/// 2.5 million on, which no longer fit in the processor's caches and which BLAS's blocking serves better
+/// (`factorization_bench`, bench/results/zen5-2core/block_solves_2026-11-30/).
 enum class BlockSolves { kAuto, kCholmod };
 
-/// The largest factor (CHOLMOD's lnz) whose four-column solves kAuto takes itself: measured between 2.3
-/// million (faster) and 2.5 million (as fast as CHOLMOD) nonzeros.
+/// The largest factor (CHOLMOD's lnz) whose four-column solves kAuto takes itself: the loops were still
+/// faster at 2.3 million nonzeros and as fast as CHOLMOD at 2.5 million (measured before the forward half
+/// took four columns at a time).
 inline constexpr double kBlockSolvesMaxNonzeros = 2.0e6;
 
 class SparseCholesky {
