@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <dlfcn.h>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
@@ -200,6 +201,60 @@ TEST(SparseCholesky, ARefactorizationSolvesAsAFreshOne) {
       EXPECT_FALSE(cholesky.refactorize(indefinite)) << name(method);
       EXPECT_FALSE(cholesky.refactorize(gridMatrix(side, rng))) << "the failed factor is gone";
     }
+}
+
+TEST(SparseCholesky, AFactorizationOnAKeptAnalysisIsAFreshOneToTheBit) {
+  // Matrices of one pattern and new values, factorized on one analysis made beforehand (analyze), solve
+  // exactly as each factorized with its own analysis does, by either method, in a given order or CHOLMOD's;
+  // threads factorizing on one shared analysis at once too. A matrix of another size is refused.
+  std::mt19937_64 rng(13);
+  for (const CholeskyMethod method : kMethods)
+    for (int side : {3, 7}) {
+      const Eigen::Index n = 3 * side * side * side;
+      for (const bool given : {true, false}) {
+        const std::vector<int> order = given ? shuffledOrder(n, rng) : std::vector<int>();
+        const std::shared_ptr<const SymbolicFactor> analysis =
+            SparseCholesky::analyze(gridMatrix(side, rng), order, method);
+        ASSERT_NE(analysis, nullptr);
+        EXPECT_EQ(analysis->rows(), n);
+        std::vector<Eigen::SparseMatrix<double>> matrices;
+        std::vector<Eigen::MatrixXd> rhs, fresh;
+        for (int values = 0; values < 4; ++values) {
+          matrices.push_back(gridMatrix(side, rng));
+          rhs.push_back(Eigen::MatrixXd::Random(n, 4));
+          SparseCholesky own(method);
+          ASSERT_TRUE(own.factorize(matrices.back(), order));
+          Eigen::MatrixXd x(n, 12);
+          x.leftCols(4) = own.solve(rhs.back());
+          ASSERT_TRUE(own.solveFactor(rhs.back().data(), x.middleCols(4, 4).data(), 4));
+          ASSERT_TRUE(own.solveFactorTransposed(rhs.back().data(), x.rightCols(4).data(), 4));
+          fresh.push_back(x);
+        }
+        const auto onAnalysis = [&](std::size_t i) {
+          SparseCholesky kept(method);
+          Eigen::MatrixXd x(n, 12);
+          if (!kept.factorize(matrices[i], *analysis)) return Eigen::MatrixXd();
+          x.leftCols(4) = kept.solve(rhs[i]);
+          kept.solveFactor(rhs[i].data(), x.middleCols(4, 4).data(), 4);
+          kept.solveFactorTransposed(rhs[i].data(), x.rightCols(4).data(), 4);
+          return x;
+        };
+        std::vector<Eigen::MatrixXd> concurrent(matrices.size());
+        std::vector<std::thread> threads;
+        for (std::size_t i = 0; i < matrices.size(); ++i)
+          threads.emplace_back([&, i] { concurrent[i] = onAnalysis(i); });
+        for (std::thread& t : threads)
+          t.join();
+        for (std::size_t i = 0; i < matrices.size(); ++i) {
+          EXPECT_EQ(onAnalysis(i), fresh[i]) << "side " << side << ", matrix " << i << ", " << name(method);
+          EXPECT_EQ(concurrent[i], fresh[i]) << "side " << side << ", matrix " << i << ", concurrently";
+        }
+        SparseCholesky wrong(method);
+        EXPECT_FALSE(wrong.factorize(gridMatrix(side + 1, rng), *analysis)) << name(method);
+      }
+    }
+  EXPECT_EQ(SparseCholesky::analyze(gridMatrix(3, rng), std::vector<int>(5, 0)), nullptr)
+      << "an order of the wrong size";
 }
 
 TEST(SparseCholesky, AnIndefiniteOrMalformedMatrixIsRefused) {

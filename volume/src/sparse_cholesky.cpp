@@ -145,6 +145,33 @@ std::vector<int> nodeBlockOrder(const Eigen::SparseMatrix<double>& matrix) {
   return order;
 }
 
+namespace {
+
+/// Starts CHOLMOD's `common` for factorizations by `method`.
+void startCommon(cholmod_common& common, CholeskyMethod method) {
+  oneOpenBlasThread();
+  cholmod_start(&common);
+  common.print = 0;  // errors are returned to the caller, not printed
+  // LLᵀ by either method, so that a matrix that is not positive definite is refused by both (a
+  // simplicial LDLᵀ would go on through an indefinite one).
+  common.final_ll = 1;
+  switch (method) {
+    case CholeskyMethod::kAuto:
+      common.supernodal = CHOLMOD_AUTO;
+      common.supernodal_switch = supernodalSwitch();
+      break;
+    case CholeskyMethod::kSimplicial:
+      common.supernodal = CHOLMOD_SIMPLICIAL;
+      break;
+    case CholeskyMethod::kSupernodal:
+      common.supernodal = CHOLMOD_SUPERNODAL;
+      break;
+  }
+  common.quick_return_if_not_posdef = 1;
+}
+
+}  // namespace
+
 /// CHOLMOD's state: its workspace (`common`), the factor, and the dense buffers cholmod_solve2 reuses from
 /// one solve to the next (mutable: a solve changes no result, only scratch space).
 struct SparseCholesky::Impl {
@@ -156,27 +183,7 @@ struct SparseCholesky::Impl {
   /// The four-column solves' workspace (blockSolves): the right-hand sides row by row, one supernode's rows.
   mutable std::vector<Eigen::Vector4d> rows, gathered;
 
-  explicit Impl(CholeskyMethod method) {
-    oneOpenBlasThread();
-    cholmod_start(&common);
-    common.print = 0;  // errors are returned to the caller, not printed
-    // LLᵀ by either method, so that a matrix that is not positive definite is refused by both (a
-    // simplicial LDLᵀ would go on through an indefinite one).
-    common.final_ll = 1;
-    switch (method) {
-      case CholeskyMethod::kAuto:
-        common.supernodal = CHOLMOD_AUTO;
-        common.supernodal_switch = supernodalSwitch();
-        break;
-      case CholeskyMethod::kSimplicial:
-        common.supernodal = CHOLMOD_SIMPLICIAL;
-        break;
-      case CholeskyMethod::kSupernodal:
-        common.supernodal = CHOLMOD_SUPERNODAL;
-        break;
-    }
-    common.quick_return_if_not_posdef = 1;
-  }
+  explicit Impl(CholeskyMethod method) { startCommon(common, method); }
   ~Impl() {
     freeFactor();
     cholmod_finish(&common);
@@ -312,7 +319,57 @@ cholmod_sparse viewOf(const Eigen::SparseMatrix<double>& matrix, int stype) {
   return a;
 }
 
+/// CHOLMOD's symbolic analysis of `matrix` in `order` (CHOLMOD's AMD when empty) with `common`'s method;
+/// null where the matrix or the order is malformed or the analysis fails. Its caller holds the call guard.
+cholmod_factor* analyzeWith(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order,
+                            cholmod_common& common) {
+  if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return nullptr;
+  if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return nullptr;
+  cholmod_sparse a = viewOf(matrix, -1);
+  common.nmethods = 1;
+  common.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
+  common.postorder = 1;
+  return cholmod_analyze_p(&a, order.empty() ? nullptr : const_cast<int*>(order.data()), nullptr, 0, &common);
+}
+
+bool outOfMemory(const cholmod_common& common) {
+  return common.status == CHOLMOD_OUT_OF_MEMORY || common.status == CHOLMOD_TOO_LARGE;
+}
+
 }  // namespace
+
+/// A symbolic factor and the CHOLMOD workspace it was allocated in (and is freed in).
+struct SymbolicFactor::Impl {
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+  double factorNonzeros = 0.0;
+  explicit Impl(CholeskyMethod method) { startCommon(common, method); }
+  ~Impl() {
+    if (factor) cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+};
+
+SymbolicFactor::SymbolicFactor(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+SymbolicFactor::~SymbolicFactor() = default;
+
+std::shared_ptr<const SymbolicFactor> SparseCholesky::analyze(const Eigen::SparseMatrix<double>& matrix,
+                                                              const std::vector<int>& order,
+                                                              CholeskyMethod method) {
+  auto impl = std::make_unique<SymbolicFactor::Impl>(method);
+  {
+    const CallGuard guard;
+    impl->factor = analyzeWith(matrix, order, impl->common);
+  }
+  if (!impl->factor) return nullptr;
+  impl->factorNonzeros = impl->common.lnz;
+  std::shared_ptr<SymbolicFactor> out(new SymbolicFactor(std::move(impl)));
+  out->mRows = matrix.rows();
+  out->mNonZeros = matrix.nonZeros();
+  return out;
+}
 
 bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const std::vector<int>& order) {
   Impl& s = *mImpl;
@@ -320,21 +377,34 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const 
   mRows = 0;
   mFailure = Failure::kOther;
   mFactorNonzeros = 0.0;
-  if (matrix.rows() != matrix.cols() || !matrix.isCompressed()) return false;
-  if (!order.empty() && static_cast<Eigen::Index>(order.size()) != matrix.rows()) return false;
-  cholmod_sparse a = viewOf(matrix, -1);
-  s.common.nmethods = 1;
-  s.common.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
-  s.common.postorder = 1;
   const CallGuard guard;
-  s.factor =
-      cholmod_analyze_p(&a, order.empty() ? nullptr : const_cast<int*>(order.data()), nullptr, 0, &s.common);
+  s.factor = analyzeWith(matrix, order, s.common);
   if (!s.factor) {
-    if (s.common.status == CHOLMOD_OUT_OF_MEMORY || s.common.status == CHOLMOD_TOO_LARGE)
-      mFailure = Failure::kOutOfMemory;
+    if (outOfMemory(s.common)) mFailure = Failure::kOutOfMemory;
     return false;
   }
   mFactorNonzeros = s.common.lnz;
+  mRows = matrix.rows();
+  return factorizeNumerically(matrix);
+}
+
+bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& matrix, const SymbolicFactor& analysis) {
+  Impl& s = *mImpl;
+  s.freeFactor();
+  mRows = 0;
+  mFailure = Failure::kOther;
+  mFactorNonzeros = 0.0;
+  if (matrix.rows() != analysis.rows() || matrix.cols() != analysis.rows() ||
+      matrix.nonZeros() != analysis.nonZeros())
+    return false;
+  const CallGuard guard;
+  // A copy of the analysis (its structure only: a symbolic factor has no values) becomes this factor.
+  s.factor = cholmod_copy_factor(analysis.mImpl->factor, &s.common);
+  if (!s.factor) {
+    if (outOfMemory(s.common)) mFailure = Failure::kOutOfMemory;
+    return false;
+  }
+  mFactorNonzeros = analysis.mImpl->factorNonzeros;
   mRows = matrix.rows();
   return factorizeNumerically(matrix);
 }
