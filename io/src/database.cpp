@@ -35,6 +35,9 @@ using Clock = std::chrono::steady_clock;
 struct CachedEntry {
   core::PhysicalData data;
   core::TetLocator locator;
+  /// The symbolic analysis of its tets' K − σM, kept by the first geometry correction that answers with
+  /// the entry for the next ones, which factorize on it.
+  mutable volume::ModalPlan modalPlan;
   const core::StretchBasis& stretchBasis() const {
     std::call_once(stretchOnce, [&] { stretch = core::computeStretchBasis(data.tetMesh, data.modes); });
     return stretch;
@@ -178,14 +181,15 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
   }
   double morphSeconds = 1e-6 * microsecondsSince(start);
 
-  const auto correct = [&](volume::MorphedEntry morphed, const core::PhysicalData& entry,
+  const auto correct = [&](volume::MorphedEntry morphed, const CachedEntry& entry,
                            const core::Mat3& orientation, const std::atomic<bool>* cancel) {
     const Clock::time_point placing = Clock::now();
     volume::placeMissingMass(morphed, volume::MorphTarget::View(*target, orientation));
     const double placed = 1e-6 * microsecondsSince(placing);
     volume::ModalOptions solve = modal;
     solve.cancel = cancel;
-    return Corrected{volume::correctMorphed(entry, std::move(morphed), solve), placed};
+    solve.plan = &entry.modalPlan;
+    return Corrected{volume::correctMorphed(entry.data, std::move(morphed), solve), placed};
   };
   const auto morphInto = [&](Morphs& into, const core::PhysicalData& entry, const core::Mat3& orientation,
                              std::size_t i) {
@@ -211,14 +215,14 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     const auto pick = [&](std::span<const char> done) -> std::optional<std::size_t> {
       return bestMorph(extra, done, /*warningFree=*/true).value_or(theCandidate);
     };
-    const auto entryOf = [&](std::size_t k) -> const core::PhysicalData& {
-      return k == theCandidate ? entries[out.answered]->data : more[k].entry->data;
+    const auto entryOf = [&](std::size_t k) -> const CachedEntry& {
+      return k == theCandidate ? *entries[out.answered] : *more[k].entry;
     };
     const auto orientationOf = [&](std::size_t k) -> const core::Mat3& {
       return k == theCandidate ? q.matches[out.answered].match.orientation : more[k].match.orientation;
     };
     morphAtOnce(
-        more.size(), [&](std::size_t i) { morphInto(extra, entryOf(i), orientationOf(i), i); }, pick,
+        more.size(), [&](std::size_t i) { morphInto(extra, entryOf(i).data, orientationOf(i), i); }, pick,
         [&](std::size_t k) { return k == theCandidate ? chosen : (*extra[k]).value(); },
         [&](std::size_t k, volume::MorphedEntry m, const std::atomic<bool>* cancel) {
           return correct(std::move(m), entryOf(k), orientationOf(k), cancel);
@@ -227,8 +231,8 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
           for (const auto& m : extra)
             if (*m) morphSeconds += (*m)->report.morphSeconds;
           const std::vector<char> all(extra.size(), 1);
-          const std::size_t k = *pick(all);              // never empty: the candidate at least
-          const core::PhysicalData& entry = entryOf(k);  // kept alive by out.fallback's entry below
+          const std::size_t k = *pick(all);       // never empty: the candidate at least
+          const CachedEntry& entry = entryOf(k);  // kept alive by out.fallback's entry below
           const core::Mat3 orientation = orientationOf(k);
           if (k != theCandidate) {
             chosen = std::move(*extra[k]).value();
@@ -249,7 +253,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
       },
       [&](std::size_t k) { return (*morphs[k]).value(); },
       [&](std::size_t k, volume::MorphedEntry m, const std::atomic<bool>* cancel) {
-        return correct(std::move(m), entries[k]->data, q.matches[k].match.orientation, cancel);
+        return correct(std::move(m), *entries[k], q.matches[k].match.orientation, cancel);
       },
       [&](std::optional<Corrected> guess) {
         for (std::size_t i = 0; i < candidates; ++i) {
@@ -272,7 +276,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
         if (sendsToFallback(chosen))
           correctWithFallback(std::move(chosen));
         else
-          c = correct(std::move(chosen), entries[*best]->data, q.matches[*best].match.orientation, nullptr);
+          c = correct(std::move(chosen), *entries[*best], q.matches[*best].match.orientation, nullptr);
       });
 
   if (!c) return out;

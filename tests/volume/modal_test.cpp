@@ -304,6 +304,50 @@ TEST(Modal, ASeededSolveGivesUpWhenCancelledAndIsUnchangedWhenNot) {
   EXPECT_EQ(cancelled.error().code, ErrorCode::kCancelled);
 }
 
+// A plan (ModalOptions::plan) keeps the first seeded solve's symbolic analysis for the next solves of the
+// same tets, wherever their nodes have moved: every solve with it gives what the same solve without one
+// gives, to the bit, for the plan's tets and for any others, which leave it as it was.
+TEST(Modal, APlanServesItsTetsWhereverTheirNodesAreAndChangesNoBit) {
+  const TetMesh mesh = tetsOrDie(core::makeBox(Vec3(1.2, 1.0, 0.7)), {.maxVolumeFraction = 1.0 / 30.0});
+  const TetMesh other = tetsOrDie(core::makeCylinder(0.5, 1.5, 16), {.maxVolumeFraction = 1.0 / 30.0});
+  TetMesh moved = mesh;  // the same tets over other nodes: an affine stretch and a bend
+  for (Vec3& p : moved.nodes)
+    p = Vec3(1.3 * p.x(), 0.8 * p.y() + 0.2 * p.x() * p.x(), p.z());
+  const ModalOptions options{.modes = 8, .material = core::unitMaterial(0.3)};
+  const Result<core::ModalData> seeds = computeModes(mesh, options);
+  const Result<core::ModalData> otherSeeds = computeModes(other, options);
+  ASSERT_TRUE(seeds.ok() && otherSeeds.ok());
+  const auto expectSame = [](const Result<core::ModalData>& a, const Result<core::ModalData>& b,
+                             const char* what) {
+    ASSERT_TRUE(a.ok() && b.ok()) << what;
+    EXPECT_EQ(a->eigenvalues, b->eigenvalues) << what;
+    EXPECT_EQ(a->shapes, b->shapes) << what;
+  };
+  for (const ElementOrder order : {ElementOrder::kQuadratic, ElementOrder::kLinear}) {
+    ModalOptions bare = options;
+    bare.order = order;
+    ModalPlan plan;
+    ModalOptions planned = bare;
+    planned.plan = &plan;
+    EXPECT_FALSE(plan.ready());
+    expectSame(computeModesFrom(mesh, seeds->shapes, planned), computeModesFrom(mesh, seeds->shapes, bare),
+               "the solve that makes the analysis");
+    EXPECT_TRUE(plan.ready());
+    expectSame(computeModesFrom(moved, seeds->shapes, planned), computeModesFrom(moved, seeds->shapes, bare),
+               "the same tets moved, on the kept analysis");
+    expectSame(computeModesFrom(other, otherSeeds->shapes, planned),
+               computeModesFrom(other, otherSeeds->shapes, bare), "other tets, which ignore the plan");
+    ModalOptions otherOrder = planned;
+    otherOrder.order = order == ElementOrder::kQuadratic ? ElementOrder::kLinear : ElementOrder::kQuadratic;
+    ModalOptions otherOrderBare = otherOrder;
+    otherOrderBare.plan = nullptr;
+    expectSame(computeModesFrom(mesh, seeds->shapes, otherOrder),
+               computeModesFrom(mesh, seeds->shapes, otherOrderBare), "the other element order");
+    expectSame(computeModesFrom(moved, seeds->shapes, planned), computeModesFrom(moved, seeds->shapes, bare),
+               "the plan's tets again, after the others");
+  }
+}
+
 // The seeded solve is block Lanczos, which hands over to the restarted single-vector Lanczos (Spectra's)
 // when its seeds span fewer directions than its block; either way its modes are those of the restarted
 // solver from a random start (computeModes). A cube's quadratic tets have repeated frequencies (its

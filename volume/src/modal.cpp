@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,11 +20,60 @@
 #include "sparse_products.h"
 
 namespace shapedb::volume {
+
+namespace detail {
+
+/// A ModalPlan's analysis and the connectivity it is of.
+struct ModalPlanState {
+  /// The analysis, where it is of `mesh`'s tets in `order`; null otherwise.
+  std::shared_ptr<const SymbolicFactor> find(const core::TetMesh& mesh, ElementOrder order) const {
+    const std::lock_guard lock(mutex);
+    return analysis && order == elementOrder && mesh.nodeCount() == nodeCount && mesh.tets == tets ? analysis
+                                                                                                   : nullptr;
+  }
+  /// Keeps `made`, the analysis of `mesh`'s tets in `order`, unless it holds one already.
+  void keep(const core::TetMesh& mesh, ElementOrder order, std::shared_ptr<const SymbolicFactor> made) {
+    const std::lock_guard lock(mutex);
+    if (analysis) return;
+    tets = mesh.tets;
+    nodeCount = mesh.nodeCount();
+    elementOrder = order;
+    analysis = std::move(made);
+  }
+  bool ready() const {
+    const std::lock_guard lock(mutex);
+    return analysis != nullptr;
+  }
+
+ private:
+  mutable std::mutex mutex;
+  std::vector<core::TetMesh::Tet> tets;
+  std::size_t nodeCount = 0;
+  ElementOrder elementOrder = ElementOrder::kQuadratic;
+  std::shared_ptr<const SymbolicFactor> analysis;
+};
+
+}  // namespace detail
+
+ModalPlan::ModalPlan() : mState(std::make_unique<detail::ModalPlanState>()) {}
+ModalPlan::~ModalPlan() = default;
+bool ModalPlan::ready() const {
+  return mState->ready();
+}
+
 namespace {
 
 using core::ModalData;
 using core::TetMesh;
 using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// Where a factorization of K − σM takes its symbolic analysis from and leaves it: `plan`'s, for `mesh`'s
+/// tets in `order` (no plan: its own, made and dropped).
+struct PlanSlot {
+  detail::ModalPlanState* plan = nullptr;
+  const TetMesh* mesh = nullptr;
+  ElementOrder order = ElementOrder::kQuadratic;
+};
 
 /// K − σM on K's pattern, which holds M's (the assembler lays M's entries out among K's): one copy of K
 /// and a merge per column. Eigen's own sum grows its result from a guess of a few entries per column,
@@ -64,9 +115,9 @@ class SymmetricShiftInvert {
  public:
   using Scalar = double;
   SymmetricShiftInvert(const SparseMatrix& k, const SparseMatrix& m, const Eigen::MatrixXd& rigid,
-                       double sigma)
+                       double sigma, const PlanSlot& slot = {})
       : mM(m), mShifted(shiftedStiffness(k, m, sigma)), mScratch(k.rows()), mProduct(k.rows()) {
-    mOk = mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
+    mOk = factorizeShifted(slot);
     if (!mOk) return;
     // Orthonormal by Householder QR: the images are orthogonal already (Rᵀ A R = −σ I, as K R = 0), up to
     // round-off.
@@ -116,6 +167,20 @@ class SymmetricShiftInvert {
   }
 
  private:
+  /// Factorizes A on the plan's analysis where it has one for these tets, else on a new one (which the
+  /// plan keeps, where there is a plan).
+  bool factorizeShifted(const PlanSlot& slot) {
+    if (!slot.plan) return mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
+    std::shared_ptr<const detail::SymbolicFactor> analysis = slot.plan->find(*slot.mesh, slot.order);
+    if (!analysis) {
+      analysis = detail::SparseCholesky::analyze(mShifted, detail::nodeBlockOrder(mShifted));
+      // Where even the analysis fails, factorize says why.
+      if (!analysis) return mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
+      slot.plan->keep(*slot.mesh, slot.order, analysis);
+    }
+    return mSolver.factorize(mShifted, *analysis);
+  }
+
   /// H⁻¹ x = Hᵀ A x.
   Eigen::MatrixXd imageOf(const Eigen::MatrixXd& x) const {
     const Eigen::MatrixXd ax = detail::symmetricProduct(mShifted, x);
@@ -733,9 +798,10 @@ std::optional<RitzPairs> blockLanczos(const SymmetricShiftInvert& op, const Eige
 /// correction 3-5 % faster at the median, 8-11 % at p90, the largest entries' 10-25 %
 /// (bench/results/xeon-2core/block_lanczos_2026-11-29.md).
 Result<ModalData> solveSeeded(const std::vector<core::Vec3>& nodes, const FemMatrices& fem,
-                              const ModalOptions& options, const Eigen::MatrixXd& seeds, int* solves) {
+                              const ModalOptions& options, const Eigen::MatrixXd& seeds, int* solves,
+                              const PlanSlot& plan) {
   const Pencil pencil = pencilOf(nodes, fem);
-  SymmetricShiftInvert op(fem.stiffness, fem.mass, pencil.rigid, pencil.sigma);
+  SymmetricShiftInvert op(fem.stiffness, fem.mass, pencil.rigid, pencil.sigma, plan);
   if (!op.ok()) return factorizationError(op, fem.stiffness.rows());
   if (cancelled(options.cancel)) return cancelledError();
   int count = 0;
@@ -863,15 +929,16 @@ Result<ModalData> computeModesFrom(const TetMesh& mesh, const Eigen::MatrixXd& s
     }
     return all;
   };
+  const PlanSlot plan{options.plan ? options.plan->mState.get() : nullptr, &mesh, options.order};
   if (options.order == ElementOrder::kQuadratic) {
     const QuadraticTetMesh quadratic = makeQuadratic(mesh);
     const FemMatrices fem = assemble(quadratic, options);
     return cornersOnly(solveSeeded(quadratic.nodes, fem, options,
-                                   normalized(fem, seedsAtAllNodes(quadratic, seeds)), solves),
+                                   normalized(fem, seedsAtAllNodes(quadratic, seeds)), solves, plan),
                        mesh.nodeCount());
   }
   const FemMatrices fem = assemble(mesh, options);
-  return solveSeeded(mesh.nodes, fem, options, normalized(fem, seeds), solves);
+  return solveSeeded(mesh.nodes, fem, options, normalized(fem, seeds), solves, plan);
 }
 
 Result<ModalData> computeModesDense(const TetMesh& mesh, const ModalOptions& options) {

@@ -3,6 +3,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -70,6 +71,12 @@ enum class ElementOrder : std::uint8_t { kLinear = 1, kQuadratic = 2 };
 const char* toString(ElementOrder order);
 std::optional<ElementOrder> parseElementOrder(std::string_view name);
 
+namespace detail {
+struct ModalPlanState;
+}
+
+class ModalPlan;
+
 /// How many modes, for which material, on which elements.
 struct ModalOptions {
   int modes = 20;  ///< non-rigid modes wanted, ≥ 1
@@ -86,6 +93,9 @@ struct ModalOptions {
   /// (it is read before the assembly, after the factorization and at each step of the block Lanczos), for
   /// work whose answer may no longer be wanted (the geometry correction's speculative modes, io/database).
   const std::atomic<bool>* cancel = nullptr;
+  /// computeModesFrom only: the connectivity's analysis, kept from one solve of the same tets to the next
+  /// (ModalPlan); none where null.
+  ModalPlan* plan = nullptr;
 };
 
 /// The first `modes` non-rigid modes of the free body, K φ = λ M φ, by shift-invert Lanczos (Spectra)
@@ -113,6 +123,28 @@ Result<core::ModalData> computeModes(const QuadraticTetMesh& mesh, const ModalOp
 /// and kCancelled once options.cancel is true.
 Result<core::ModalData> computeModesFrom(const core::TetMesh& mesh, const Eigen::MatrixXd& seeds,
                                          const ModalOptions& options, int* solves = nullptr);
+
+/// What computeModesFrom works out from a tet mesh's connectivity alone, whatever its nodes' positions: the
+/// symbolic analysis of its K − σM (the fill-reducing order, the factor's structure). The geometry
+/// correction solves one database entry's tets, moved onto the query, at every query that entry answers:
+/// given in ModalOptions::plan, a plan keeps the first solve's analysis, and the later solves of the same
+/// tets factorize on it (the same factor and modes, to the bit, without a tenth of their time). It serves
+/// the connectivity and element order it was first used with; a solve of other tets ignores it and
+/// leaves it as it is. Thread-safe: concurrent solves may share one.
+class ModalPlan {
+ public:
+  ModalPlan();
+  ~ModalPlan();
+  ModalPlan(const ModalPlan&) = delete;
+  ModalPlan& operator=(const ModalPlan&) = delete;
+  /// Whether a solve has left its analysis here.
+  bool ready() const;
+
+ private:
+  friend Result<core::ModalData> computeModesFrom(const core::TetMesh&, const Eigen::MatrixXd&,
+                                                  const ModalOptions&, int*);
+  std::unique_ptr<detail::ModalPlanState> mState;
+};
 
 /// The oracle: the same modes from a dense generalized eigensolver over all 3n degrees of freedom
 /// (Eigen's GeneralizedSelfAdjointEigenSolver, O(n³)), of options.order. For meshes of a few hundred nodes
