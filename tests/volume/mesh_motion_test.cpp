@@ -127,5 +127,45 @@ TEST(MeshMotion, TheInteriorFollowsAsADenseSolveSaysCallAfterCall) {
   }
 }
 
+TEST(MeshMotion, ExtendingFromAnAnchorIsExtendingToTheBit) {
+  // The morph's projection tries several moves from one configuration, with other increments between:
+  // extendFromAnchor reuses that configuration's factor and gives what extend gives, exactly, also once
+  // it is called from other positions (a new anchor).
+  const TetMesh start = ellipsoidTets();
+  std::vector<char> isBoundary(start.nodeCount(), 0);
+  std::size_t boundaryCount = 0;
+  for (const core::BoundaryFace& f : core::boundaryFaces(start))
+    for (std::uint32_t n : f.nodes)
+      isBoundary[n] = 1;
+  for (char b : isBoundary)
+    boundaryCount += b ? 1 : 0;
+  InteriorMotion plain(start, isBoundary), anchored(start, isBoundary);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> d(-0.02, 0.02);
+  const auto randomMove = [&] {
+    Eigen::VectorXd move(3 * static_cast<Eigen::Index>(boundaryCount));
+    for (Eigen::Index i = 0; i < move.size(); ++i)
+      move[i] = d(rng);
+    return move;
+  };
+  TetMesh from = start;
+  for (int anchor = 0; anchor < 2; ++anchor) {
+    for (int call = 0; call < 3; ++call) {
+      const Eigen::VectorXd move = randomMove();
+      TetMesh expected = from, got = from;
+      ASSERT_TRUE(plain.extend(expected, move).ok());
+      ASSERT_TRUE(anchored.extendFromAnchor(got, move).ok());
+      EXPECT_EQ(got.nodes, expected.nodes) << "anchor " << anchor << ", call " << call;
+      EXPECT_NE(got.nodes, from.nodes);
+      // An increment from elsewhere in between, as the morph's later increments are.
+      const Eigen::VectorXd further = randomMove();
+      ASSERT_TRUE(anchored.extend(got, further).ok());
+      ASSERT_TRUE(plain.extend(expected, further).ok());
+      EXPECT_EQ(got.nodes, expected.nodes);
+    }
+    ASSERT_TRUE(plain.extend(from, randomMove()).ok());  // the next anchor
+  }
+}
+
 }  // namespace
 }  // namespace shapedb::volume::detail

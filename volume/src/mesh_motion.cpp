@@ -178,12 +178,8 @@ InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoun
   }
 }
 
-Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
-  if (mInnerCount == 0) {
-    for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
-      mesh.nodes[v] += boundaryMove.segment<3>(3 * mBoundarySlot[v]);
-    return Ok{};
-  }
+Eigen::VectorXd InteriorMotion::assemble(const TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
+                                         std::vector<RhsBlock>* blocks) {
   // K_ii and −K_ib u_b, assembled on the mesh as it stands before this increment: the blocks of the inner
   // nodes' rows only.
   double* kii = mKii.valuePtr();
@@ -206,13 +202,30 @@ Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove
             for (Eigen::Index r = 0; r < 3; ++r)
               kii[start + j * stride + r] += block(r, j);
         } else {
-          rhs.segment<3>(3 * row) -= block * boundaryMove.segment<3>(3 * mBoundarySlot[tet[b]]);
+          const int slot = mBoundarySlot[tet[b]];
+          rhs.segment<3>(3 * row) -= block * boundaryMove.segment<3>(3 * slot);
+          if (blocks) blocks->push_back({row, slot, block});
         }
       }
     }
   }
+  return rhs;
+}
+
+void InteriorMotion::move(TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
+                          const Eigen::VectorXd& inner) const {
   for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
     if (const int slot = mBoundarySlot[v]; slot >= 0) mesh.nodes[v] += boundaryMove.segment<3>(3 * slot);
+  for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
+    if (const int i = mInner[v]; i >= 0) mesh.nodes[v] += inner.segment<3>(3 * i);
+}
+
+Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
+  if (mInnerCount == 0) {
+    move(mesh, boundaryMove, Eigen::VectorXd());
+    return Ok{};
+  }
+  const Eigen::VectorXd rhs = assemble(mesh, boundaryMove, nullptr);
   if (!mAnalyzed) {
     mSolver.analyzePattern(mKii);
     mAnalyzed = true;
@@ -220,9 +233,28 @@ Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove
   mSolver.factorize(mKii);
   if (mSolver.info() != Eigen::Success)
     return Error{ErrorCode::kInvalidArgument, "the mesh-motion system could not be factorized"};
-  const Eigen::VectorXd u = mSolver.solve(rhs);
-  for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
-    if (const int i = mInner[v]; i >= 0) mesh.nodes[v] += u.segment<3>(3 * i);
+  move(mesh, boundaryMove, mSolver.solve(rhs));
+  return Ok{};
+}
+
+Status InteriorMotion::extendFromAnchor(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
+  if (mInnerCount == 0) return extend(mesh, boundaryMove);
+  Eigen::VectorXd rhs;
+  if (mesh.nodes == mAnchor) {
+    // −K_ib u_b from the kept blocks, in the order extend adds them.
+    rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
+    for (const RhsBlock& b : mAnchorBlocks)
+      rhs.segment<3>(3 * b.row) -= b.block * boundaryMove.segment<3>(3 * b.slot);
+  } else {
+    mAnchor.clear();
+    mAnchorBlocks.clear();
+    rhs = assemble(mesh, boundaryMove, &mAnchorBlocks);
+    mAnchorSolver.compute(mKii);
+    if (mAnchorSolver.info() != Eigen::Success)
+      return Error{ErrorCode::kInvalidArgument, "the mesh-motion system could not be factorized"};
+    mAnchor = mesh.nodes;
+  }
+  move(mesh, boundaryMove, mAnchorSolver.solve(rhs));
   return Ok{};
 }
 

@@ -72,8 +72,26 @@ class InteriorMotion {
   /// Moves `mesh`'s boundary nodes by `boundaryMove` (3 per boundary node, ascending node order) and its
   /// inner nodes as the elastic body would. Errors when the system cannot be factorized.
   Status extend(core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove);
+  /// extend from one configuration again and again: the first call (or one from other positions) assembles
+  /// and factorizes the system at `mesh`'s positions as extend does, and keeps the factor and the right-hand
+  /// side's blocks; a later call from the same positions reuses them. The same result as extend, to the bit.
+  /// The morph's projection starts each of its attempts from one configuration.
+  Status extendFromAnchor(core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove);
 
  private:
+  /// One block of −K_ib u_b: inner row `row` (an index among the inner nodes) takes `block` times the move
+  /// of the boundary node in slot `slot`.
+  struct RhsBlock {
+    int row, slot;
+    core::Mat3 block;
+  };
+  /// K_ii into mKii's values and −K_ib u_b at `mesh`'s positions, before `boundaryMove`; the blocks of the
+  /// latter also into `blocks` where given, in the order they were added.
+  Eigen::VectorXd assemble(const core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
+                           std::vector<RhsBlock>* blocks);
+  /// Moves the boundary nodes by `boundaryMove` and the inner ones by `inner`.
+  void move(core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove, const Eigen::VectorXd& inner) const;
+
   MotionStiffness mStiffness;
   std::vector<int> mInner;         ///< per node: its index among the inner nodes, or −1
   std::vector<int> mBoundarySlot;  ///< per node: its index among the boundary nodes, or −1
@@ -89,6 +107,10 @@ class InteriorMotion {
   std::vector<ActiveTet> mActiveTets;
   Eigen::SimplicialLDLT<SparseMatrix> mSolver;
   bool mAnalyzed = false;
+  /// extendFromAnchor's: the positions it was factorized at, its factor, its right-hand side's blocks.
+  std::vector<core::Vec3> mAnchor;
+  Eigen::SimplicialLDLT<SparseMatrix> mAnchorSolver;
+  std::vector<RhsBlock> mAnchorBlocks;
 };
 
 }  // namespace shapedb::volume::detail

@@ -340,9 +340,13 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
       step.segment<3>(3 * static_cast<Eigen::Index>(i)) *= taken[i];
     std::vector<std::size_t> bad;
     for (const int increments : incrementSteps) {
+      // Every attempt's first increment starts from `start`: its system is factorized once for all.
       TetMesh moved = start;
       for (int k = 0; k < increments; ++k)
-        if (Status st = motion.extend(moved, step / increments); !st) return st.error();
+        if (Status st = k == 0 ? motion.extendFromAnchor(moved, step / increments)
+                               : motion.extend(moved, step / increments);
+            !st)
+          return st.error();
       bad.clear();
       for (std::size_t t = 0; t < moved.tetCount(); ++t)
         if (tetQuality(moved, t) < minQuality) bad.push_back(t);
