@@ -35,8 +35,9 @@ using Clock = std::chrono::steady_clock;
 struct CachedEntry {
   core::PhysicalData data;
   core::TetLocator locator;
-  /// The symbolic analysis of its tets' K − σM, kept by the first geometry correction that answers with
-  /// the entry for the next ones, which factorize on it.
+  /// What the geometry corrections with the entry share, kept by the first for the next ones: the layout
+  /// of its tets' morph, and the symbolic analysis of their K − σM.
+  mutable volume::MorphPlan morphPlan;
   mutable volume::ModalPlan modalPlan;
   const core::StretchBasis& stretchBasis() const {
     std::call_once(stretchOnce, [&] { stretch = core::computeStretchBasis(data.tetMesh, data.modes); });
@@ -191,9 +192,11 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
     solve.plan = &entry.modalPlan;
     return Corrected{volume::correctMorphed(entry.data, std::move(morphed), solve), placed};
   };
-  const auto morphInto = [&](Morphs& into, const core::PhysicalData& entry, const core::Mat3& orientation,
+  const auto morphInto = [&](Morphs& into, const CachedEntry& entry, const core::Mat3& orientation,
                              std::size_t i) {
-    into[i] = volume::morphEntry(entry, volume::MorphTarget::View(*target, orientation), options,
+    volume::CorrectionOptions morph = options;
+    morph.morph.plan = &entry.morphPlan;
+    into[i] = volume::morphEntry(entry.data, volume::MorphTarget::View(*target, orientation), morph,
                                  volume::MissingMass::kDeferred);
   };
   const auto sendsToFallback = [&](const volume::MorphedEntry& m) {
@@ -222,7 +225,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
       return k == theCandidate ? q.matches[out.answered].match.orientation : more[k].match.orientation;
     };
     morphAtOnce(
-        more.size(), [&](std::size_t i) { morphInto(extra, entryOf(i).data, orientationOf(i), i); }, pick,
+        more.size(), [&](std::size_t i) { morphInto(extra, entryOf(i), orientationOf(i), i); }, pick,
         [&](std::size_t k) { return k == theCandidate ? chosen : (*extra[k]).value(); },
         [&](std::size_t k, volume::MorphedEntry m, const std::atomic<bool>* cancel) {
           return correct(std::move(m), entryOf(k), orientationOf(k), cancel);
@@ -244,8 +247,7 @@ Correction correctAmongCandidates(const core::TriangleMesh& mesh, const QueryRes
   };
 
   morphAtOnce(
-      candidates,
-      [&](std::size_t i) { morphInto(morphs, entries[i]->data, q.matches[i].match.orientation, i); },
+      candidates, [&](std::size_t i) { morphInto(morphs, *entries[i], q.matches[i].match.orientation, i); },
       // No guess where the best so far, if it stays the best, sends the correction to its fallback.
       [&](std::span<const char> done) -> std::optional<std::size_t> {
         const std::optional<std::size_t> best = bestMorph(morphs, done);

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -122,6 +125,55 @@ TEST(Morph, APreparedTargetSeenThroughAFrameMorphsAsACopyCarriedIntoIt) {
       ASSERT_LT((viewed->mesh.nodes[v] - copied->mesh.nodes[v]).norm(), 1e-8)
           << "trial " << trial << " node " << v;
   }
+}
+
+// A plan (MorphOptions::plan) keeps the first morph's layout for the next morphs of the same tets: each
+// morph with it is the morph without one, to the bit (nodes and report), onto any target, for the plan's
+// tets and for others, which leave it as it was; morphs sharing it at once too.
+TEST(Morph, APlanServesItsTetsOntoAnyTargetAndChangesNoBit) {
+  Result<TetMesh> ellipsoid = tetrahedralize(core::makeUvEllipsoid(Vec3(1.0, 0.8, 0.6), 16, 8),
+                                             entryMeshing(ElementOrder::kQuadratic));
+  Result<TetMesh> box =
+      tetrahedralize(core::makeBox(Vec3(1.6, 1.0, 0.8)), entryMeshing(ElementOrder::kQuadratic));
+  ASSERT_TRUE(ellipsoid.ok() && box.ok());
+  std::vector<core::TriangleMesh> targets{core::makeBox(Vec3(2.2, 1.1, 0.7)),
+                                          core::makeCylinder(0.6, 1.8, 24),
+                                          core::makeUvEllipsoid(Vec3(1.2, 0.5, 0.9), 20, 10)};
+  for (Vec3& p : targets[0].vertices) {  // twisted: every step of the morph has work to do
+    const double a = 0.4 * p.x();
+    p = Vec3(p.x(), std::cos(a) * p.y() - std::sin(a) * p.z(), std::sin(a) * p.y() + std::cos(a) * p.z());
+  }
+  const auto expectSame = [](const Result<MorphResult>& a, const Result<MorphResult>& b,
+                             const std::string& what) {
+    ASSERT_TRUE(a.ok() && b.ok()) << what;
+    EXPECT_EQ(a->mesh.nodes, b->mesh.nodes) << what;
+    EXPECT_EQ(a->report.meanTargetDistance, b->report.meanTargetDistance) << what;
+    EXPECT_EQ(a->report.worstQuality, b->report.worstQuality) << what;
+    EXPECT_EQ(a->report.increments, b->report.increments) << what;
+    EXPECT_EQ(a->report.projected, b->report.projected) << what;
+  };
+  MorphPlan plan;
+  MorphOptions planned;
+  planned.plan = &plan;
+  for (std::size_t t = 0; t < targets.size(); ++t) {
+    const std::string what = "target " + std::to_string(t);
+    expectSame(morphTetMesh(*ellipsoid, targets[t], planned), morphTetMesh(*ellipsoid, targets[t]),
+               what + ", the plan's tets");
+    EXPECT_TRUE(plan.ready());
+    expectSame(morphTetMesh(*box, targets[t], planned), morphTetMesh(*box, targets[t]),
+               what + ", other tets");
+  }
+  Result<MorphTarget> prepared = MorphTarget::prepare(targets[1]);
+  ASSERT_TRUE(prepared.ok());
+  const Result<MorphResult> alone = morphTetMesh(*ellipsoid, prepared->view());
+  std::vector<Result<MorphResult>> together(4, Error{ErrorCode::kInvalidArgument, "not run"});
+  std::vector<std::thread> threads;
+  for (std::size_t i = 0; i < together.size(); ++i)
+    threads.emplace_back([&, i] { together[i] = morphTetMesh(*ellipsoid, prepared->view(), planned); });
+  for (std::thread& thread : threads)
+    thread.join();
+  for (const Result<MorphResult>& r : together)
+    expectSame(r, alone, "at once");
 }
 
 TEST(Morph, BadInputIsAnError) {

@@ -178,6 +178,14 @@ InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoun
   }
 }
 
+InteriorMotion::InteriorMotion(const InteriorMotion& other)
+    : mStiffness(other.mStiffness),
+      mInner(other.mInner),
+      mBoundarySlot(other.mBoundarySlot),
+      mInnerCount(other.mInnerCount),
+      mKii(other.mKii),
+      mActiveTets(other.mActiveTets) {}
+
 Eigen::VectorXd InteriorMotion::assemble(const TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
                                          std::vector<RhsBlock>* blocks) {
   // K_ii and −K_ib u_b, assembled on the mesh as it stands before this increment: the blocks of the inner

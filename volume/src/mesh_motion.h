@@ -65,6 +65,9 @@ class InteriorMotion {
  public:
   /// `isBoundary[v]`: node v's displacement is given.
   InteriorMotion(const core::TetMesh& mesh, std::span<const char> isBoundary);
+  /// The same layout, to extend on its own (no factor is copied: the copy factorizes its own).
+  InteriorMotion(const InteriorMotion& other);
+  InteriorMotion& operator=(const InteriorMotion&) = delete;
 
   /// The mesh-motion stiffness of the same tets, laid out (for others to assemble on them).
   MotionStiffness& stiffness() { return mStiffness; }

@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <span>
 #include <string>
 #include <vector>
@@ -100,7 +102,7 @@ std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh)
 /// the first search): each search starts from it, as a node moves little from round to round.
 void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTarget::View& target, int rounds,
                          double minQuality, detail::MotionStiffness& stiffness,
-                         std::vector<std::uint32_t>& nearest) {
+                         const detail::SymbolicFactor* analysis, std::vector<std::uint32_t>& nearest) {
   if (rounds <= 0) return;
   const TetMesh start = mesh;
   const SparseMatrix k = stiffness.assemble(start);
@@ -114,9 +116,10 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
     stiffnessScale += k.coeff(i, i);
   for (double a : nodeArea)
     fitScale += 3.0 * a;
-  // CHOLMOD's factor, in a node-block order worked out once: K's sparsity holds the fit's.
+  // CHOLMOD's factor, in a node-block order worked out once (or kept, `analysis`): K's sparsity holds the
+  // fit's.
   detail::SparseCholesky solver;
-  const std::vector<int> order = detail::nodeBlockOrder(k);
+  const std::vector<int> order = analysis ? std::vector<int>() : detail::nodeBlockOrder(k);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
   SparseMatrix a = k;
   // Per target point, the boundary face its closest point was last found on: the faces keep their
@@ -178,7 +181,10 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
     }
     if (!inPattern) break;  // cannot be: two nodes of a boundary face share its tet
     // Every round's A has K's sparsity: the first round's analysis serves them all.
-    if (!(round == 0 ? solver.factorize(a, order) : solver.refactorize(a))) break;
+    const bool factorized = round > 0  ? solver.refactorize(a)
+                            : analysis ? solver.factorize(a, *analysis)
+                                       : solver.factorize(a, order);
+    if (!factorized) break;
     // The fit terms hold the start configuration's rigid motions, so the system is definite.
     Eigen::VectorXd next(n);
     if (!solver.solve(rhs.data(), next.data())) break;
@@ -200,6 +206,68 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
 }
 
 }  // namespace
+
+namespace detail {
+
+/// What morphTetMesh works out from the tets' connectivity alone (MorphPlan): immutable once made, shared by
+/// the morphs of those tets.
+struct MorphLayout {
+  MorphLayout(const TetMesh& mesh, int registrationRounds)
+      : boundary(findBoundary(mesh)), isBoundary(mesh.nodeCount(), 0), motion(mesh, markBoundary()) {
+    if (registrationRounds > 0) {
+      // The registration's system has K's sparsity (the fit couples nodes of one boundary face only).
+      const SparseMatrix& pattern = motion.stiffness().matrix();
+      registration = SparseCholesky::analyze(pattern, nodeBlockOrder(pattern));
+    }
+  }
+  Boundary boundary;
+  std::vector<char> isBoundary;  ///< per node
+  InteriorMotion motion;         ///< its layout, copied by each morph (which writes its values)
+  /// The analysis of the registration's system; null where not made.
+  std::shared_ptr<const SymbolicFactor> registration;
+
+ private:
+  const std::vector<char>& markBoundary() {
+    for (std::uint32_t node : boundary.nodes)
+      isBoundary[node] = 1;
+    return isBoundary;
+  }
+};
+
+/// A MorphPlan's layout and the connectivity it is of.
+struct MorphPlanState {
+  /// The layout, where it is of `mesh`'s tets; null otherwise.
+  std::shared_ptr<const MorphLayout> find(const TetMesh& mesh) const {
+    const std::lock_guard lock(mutex);
+    return layout && mesh.nodeCount() == nodeCount && mesh.tets == tets ? layout : nullptr;
+  }
+  /// Keeps `made`, the layout of `mesh`'s tets, unless it holds one already.
+  void keep(const TetMesh& mesh, std::shared_ptr<const MorphLayout> made) {
+    const std::lock_guard lock(mutex);
+    if (layout) return;
+    tets = mesh.tets;
+    nodeCount = mesh.nodeCount();
+    layout = std::move(made);
+  }
+  bool ready() const {
+    const std::lock_guard lock(mutex);
+    return layout != nullptr;
+  }
+
+ private:
+  mutable std::mutex mutex;
+  std::vector<TetMesh::Tet> tets;
+  std::size_t nodeCount = 0;
+  std::shared_ptr<const MorphLayout> layout;
+};
+
+}  // namespace detail
+
+MorphPlan::MorphPlan() : mState(std::make_unique<detail::MorphPlanState>()) {}
+MorphPlan::~MorphPlan() = default;
+bool MorphPlan::ready() const {
+  return mState->ready();
+}
 
 double tetQuality(const TetMesh& mesh, std::size_t t) {
   const auto& tet = mesh.tets[t];
@@ -302,15 +370,19 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
     }
   }
 
-  // Elastic registration, then every boundary node onto its closest target point.
-  const Boundary boundary = findBoundary(out.mesh);
-  std::vector<char> isBoundary(out.mesh.nodeCount(), 0);
-  for (std::uint32_t node : boundary.nodes)
-    isBoundary[node] = 1;
-  detail::InteriorMotion motion(out.mesh, isBoundary);
+  // Elastic registration, then every boundary node onto its closest target point. The boundary and the
+  // systems' layouts are the plan's where it has them for these tets.
+  std::shared_ptr<const detail::MorphLayout> layout =
+      options.plan ? options.plan->mState->find(mesh) : nullptr;
+  if (!layout) {
+    layout = std::make_shared<const detail::MorphLayout>(mesh, options.registrationRounds);
+    if (options.plan) options.plan->mState->keep(mesh, layout);
+  }
+  const Boundary& boundary = layout->boundary;
+  detail::InteriorMotion motion = layout->motion;
   std::vector<std::uint32_t> nearest(boundary.nodes.size(), MorphTarget::kNoHint);
   registerElastically(out.mesh, boundary, target, options.registrationRounds, minQuality, motion.stiffness(),
-                      nearest);
+                      layout->registration.get(), nearest);
   std::vector<Vec3> p(boundary.nodes.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (nearest[i] == MorphTarget::kNoHint && i > 0) nearest[i] = nearest[i - 1];

@@ -5,6 +5,7 @@
 // within what the entry's resolution can hold.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -16,6 +17,12 @@
 #include <shapedb/core/types.h>
 
 namespace shapedb::volume {
+
+namespace detail {
+struct MorphPlanState;
+}
+
+class MorphPlan;
 
 /// How morphTetMesh moves the nodes.
 struct MorphOptions {
@@ -35,6 +42,8 @@ struct MorphOptions {
   /// if that is lower. Below it a tet is nearly inverted, and its stiffness garbage: the morph goes no
   /// further than this bound allows.
   double minQuality = 0.02;
+  /// What the morphs of the same tets share, kept from one to the next (MorphPlan); none where null.
+  MorphPlan* plan = nullptr;
 };
 
 /// What the morph did, in the mesh's units.
@@ -156,5 +165,27 @@ Result<MorphResult> morphTetMesh(const core::TetMesh& mesh, const core::Triangle
 /// target's surface carried into the mesh's frame, to round-off; its test compares the two).
 Result<MorphResult> morphTetMesh(const core::TetMesh& mesh, const MorphTarget::View& target,
                                  const MorphOptions& options = {});
+
+/// What morphTetMesh works out from a tet mesh's connectivity alone, whatever its nodes' positions: its
+/// boundary, the layout of the mesh-motion stiffness and of the interior's system, and the symbolic
+/// analysis of the registration's system. A query morphs the tets of the same database entries again and
+/// again: given in MorphOptions::plan, a plan keeps the first morph's and the later morphs of the same tets
+/// start from it (the same morph, to the bit, without a tenth of its time). It serves the connectivity it
+/// was first used with; a morph of other tets ignores it and leaves it as it is. Thread-safe: concurrent
+/// morphs may share one.
+class MorphPlan {
+ public:
+  MorphPlan();
+  ~MorphPlan();
+  MorphPlan(const MorphPlan&) = delete;
+  MorphPlan& operator=(const MorphPlan&) = delete;
+  /// Whether a morph has left its layout here.
+  bool ready() const;
+
+ private:
+  friend Result<MorphResult> morphTetMesh(const core::TetMesh&, const MorphTarget::View&,
+                                          const MorphOptions&);
+  std::unique_ptr<detail::MorphPlanState> mState;
+};
 
 }  // namespace shapedb::volume
