@@ -99,9 +99,14 @@ MotionStiffness::MotionStiffness(const TetMesh& mesh) : mNeighbours(nodeNeighbou
 }
 
 const SparseMatrix& MotionStiffness::assemble(const TetMesh& mesh) {
-  double* values = mK.valuePtr();
-  std::fill_n(values, mK.nonZeros(), 0.0);
-  const int* outer = mK.outerIndexPtr();
+  assemble(mesh, mK);
+  return mK;
+}
+
+void MotionStiffness::assemble(const TetMesh& mesh, SparseMatrix& into) const {
+  double* values = into.valuePtr();
+  std::fill_n(values, into.nonZeros(), 0.0);
+  const int* outer = into.outerIndexPtr();
   for (std::size_t t = 0; t < mesh.tetCount(); ++t)
     forEachElementBlock(mesh, t, [&](int a, int b, const core::Mat3& block) {
       const std::uint32_t v = mesh.tets[t][static_cast<std::size_t>(b)];
@@ -112,7 +117,6 @@ const SparseMatrix& MotionStiffness::assemble(const TetMesh& mesh) {
           column[i] += block(i, j);
       }
     });
-  return mK;
 }
 
 Eigen::Index MotionStiffness::valueIndex(std::uint32_t u, std::uint32_t v, int i, int j) const {
@@ -130,61 +134,59 @@ std::array<Eigen::Index, 3> MotionStiffness::diagonalIndices(std::uint32_t u, st
   return {first, first - outer[0] + outer[1] + 1, first - outer[0] + outer[2] + 2};
 }
 
-InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoundary) : mStiffness(mesh) {
+InteriorMotion::Layout::Layout(const TetMesh& mesh, std::span<const char> isBoundary) : stiffness(mesh) {
   const std::size_t n = mesh.nodeCount();
-  mInner.assign(n, -1);
-  mBoundarySlot.assign(n, -1);
+  inner.assign(n, -1);
+  boundarySlot.assign(n, -1);
   int boundaryCount = 0;
   for (std::size_t v = 0; v < n; ++v) {
     if (isBoundary[v])
-      mBoundarySlot[v] = boundaryCount++;
+      boundarySlot[v] = boundaryCount++;
     else
-      mInner[v] = mInnerCount++;
+      inner[v] = innerCount++;
   }
-  if (mInnerCount == 0) return;
+  if (innerCount == 0) return;
   // K_ii: K's rows and columns of the inner nodes. Inner nodes are numbered in the mesh's order, so each
   // column's rows stay ascending, and a node's three columns have the same rows, as in K.
-  const SparseMatrix& k = mStiffness.matrix();
+  const SparseMatrix& k = stiffness.matrix();
   std::vector<Eigen::Index> toInner(static_cast<std::size_t>(k.nonZeros()), -1);  // K's value → K_ii's
-  mKii.resize(3 * mInnerCount, 3 * mInnerCount);
-  std::vector<int> outer(static_cast<std::size_t>(3 * mInnerCount) + 1, 0), inner;
+  kii.resize(3 * innerCount, 3 * innerCount);
+  std::vector<int> outer(static_cast<std::size_t>(3 * innerCount) + 1, 0), rows;
   for (Eigen::Index col = 0; col < k.outerSize(); ++col) {
-    const int v = mInner[static_cast<std::size_t>(col / 3)];
+    const int v = inner[static_cast<std::size_t>(col / 3)];
     if (v < 0) continue;
     const auto innerCol = static_cast<std::size_t>(3 * v + col % 3);
     for (Eigen::Index at = k.outerIndexPtr()[col]; at < k.outerIndexPtr()[col + 1]; ++at) {
-      const int row = k.innerIndexPtr()[at], u = mInner[static_cast<std::size_t>(row / 3)];
+      const int row = k.innerIndexPtr()[at], u = inner[static_cast<std::size_t>(row / 3)];
       if (u < 0) continue;
-      toInner[static_cast<std::size_t>(at)] = static_cast<Eigen::Index>(inner.size());
-      inner.push_back(3 * u + row % 3);
+      toInner[static_cast<std::size_t>(at)] = static_cast<Eigen::Index>(rows.size());
+      rows.push_back(3 * u + row % 3);
     }
-    outer[innerCol + 1] = static_cast<int>(inner.size());
+    outer[innerCol + 1] = static_cast<int>(rows.size());
   }
-  mKii.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
-  std::copy(outer.begin(), outer.end(), mKii.outerIndexPtr());
-  std::copy(inner.begin(), inner.end(), mKii.innerIndexPtr());
-  std::fill_n(mKii.valuePtr(), mKii.nonZeros(), 0.0);
+  kii.resizeNonZeros(static_cast<Eigen::Index>(rows.size()));
+  std::copy(outer.begin(), outer.end(), kii.outerIndexPtr());
+  std::copy(rows.begin(), rows.end(), kii.innerIndexPtr());
+  std::fill_n(kii.valuePtr(), kii.nonZeros(), 0.0);
   for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
     const auto& tet = mesh.tets[t];
-    if (std::none_of(tet.begin(), tet.end(), [&](std::uint32_t v) { return mInner[v] >= 0; })) continue;
-    ActiveTet& active = mActiveTets.emplace_back();
+    if (std::none_of(tet.begin(), tet.end(), [&](std::uint32_t v) { return inner[v] >= 0; })) continue;
+    ActiveTet& active = activeTets.emplace_back();
     active.tet = static_cast<std::uint32_t>(t);
     for (std::size_t a = 0; a < 4; ++a)
       for (std::size_t b = 0; b < 4; ++b) {
-        const bool both = mInner[tet[a]] >= 0 && mInner[tet[b]] >= 0;
+        const bool both = inner[tet[a]] >= 0 && inner[tet[b]] >= 0;
         active.blockStart[4 * a + b] =
-            both ? toInner[static_cast<std::size_t>(mStiffness.valueIndex(tet[a], tet[b], 0, 0))] : -1;
+            both ? toInner[static_cast<std::size_t>(stiffness.valueIndex(tet[a], tet[b], 0, 0))] : -1;
       }
   }
 }
 
-InteriorMotion::InteriorMotion(const InteriorMotion& other)
-    : mStiffness(other.mStiffness),
-      mInner(other.mInner),
-      mBoundarySlot(other.mBoundarySlot),
-      mInnerCount(other.mInnerCount),
-      mKii(other.mKii),
-      mActiveTets(other.mActiveTets) {}
+InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoundary)
+    : InteriorMotion(std::make_shared<const Layout>(mesh, isBoundary)) {}
+
+InteriorMotion::InteriorMotion(std::shared_ptr<const Layout> layout)
+    : mLayout(std::move(layout)), mKii(mLayout->kii) {}
 
 Eigen::VectorXd InteriorMotion::assemble(const TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
                                          std::vector<RhsBlock>* blocks) {
@@ -193,24 +195,24 @@ Eigen::VectorXd InteriorMotion::assemble(const TetMesh& mesh, const Eigen::Vecto
   double* kii = mKii.valuePtr();
   const int* kiiColumns = mKii.outerIndexPtr();
   std::fill_n(kii, mKii.nonZeros(), 0.0);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
-  for (const ActiveTet& active : mActiveTets) {
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * mLayout->innerCount);
+  for (const Layout::ActiveTet& active : mLayout->activeTets) {
     const auto& tet = mesh.tets[active.tet];
     const auto [grad, volume] = core::tetGradients(mesh, active.tet);
     for (std::size_t a = 0; a < 4; ++a) {
-      const int row = mInner[tet[a]];
+      const int row = mLayout->inner[tet[a]];
       if (row < 0) continue;
       for (std::size_t b = 0; b < 4; ++b) {
         const core::Mat3 block =
             elementBlock(grad.col(static_cast<Eigen::Index>(a)), grad.col(static_cast<Eigen::Index>(b)));
         if (const Eigen::Index start = active.blockStart[4 * a + b]; start >= 0) {
-          const int column = 3 * mInner[tet[b]];  // b's three K_ii columns are of one length
+          const int column = 3 * mLayout->inner[tet[b]];  // b's three K_ii columns are of one length
           const Eigen::Index stride = kiiColumns[column + 1] - kiiColumns[column];
           for (Eigen::Index j = 0; j < 3; ++j)
             for (Eigen::Index r = 0; r < 3; ++r)
               kii[start + j * stride + r] += block(r, j);
         } else {
-          const int slot = mBoundarySlot[tet[b]];
+          const int slot = mLayout->boundarySlot[tet[b]];
           rhs.segment<3>(3 * row) -= block * boundaryMove.segment<3>(3 * slot);
           if (blocks) blocks->push_back({row, slot, block});
         }
@@ -223,13 +225,14 @@ Eigen::VectorXd InteriorMotion::assemble(const TetMesh& mesh, const Eigen::Vecto
 void InteriorMotion::move(TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
                           const Eigen::VectorXd& inner) const {
   for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
-    if (const int slot = mBoundarySlot[v]; slot >= 0) mesh.nodes[v] += boundaryMove.segment<3>(3 * slot);
+    if (const int slot = mLayout->boundarySlot[v]; slot >= 0)
+      mesh.nodes[v] += boundaryMove.segment<3>(3 * slot);
   for (std::size_t v = 0; v < mesh.nodeCount(); ++v)
-    if (const int i = mInner[v]; i >= 0) mesh.nodes[v] += inner.segment<3>(3 * i);
+    if (const int i = mLayout->inner[v]; i >= 0) mesh.nodes[v] += inner.segment<3>(3 * i);
 }
 
 Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
-  if (mInnerCount == 0) {
+  if (mLayout->innerCount == 0) {
     move(mesh, boundaryMove, Eigen::VectorXd());
     return Ok{};
   }
@@ -246,11 +249,11 @@ Status InteriorMotion::extend(TetMesh& mesh, const Eigen::VectorXd& boundaryMove
 }
 
 Status InteriorMotion::extendFromAnchor(TetMesh& mesh, const Eigen::VectorXd& boundaryMove) {
-  if (mInnerCount == 0) return extend(mesh, boundaryMove);
+  if (mLayout->innerCount == 0) return extend(mesh, boundaryMove);
   Eigen::VectorXd rhs;
   if (mesh.nodes == mAnchor) {
     // −K_ib u_b from the kept blocks, in the order extend adds them.
-    rhs = Eigen::VectorXd::Zero(3 * mInnerCount);
+    rhs = Eigen::VectorXd::Zero(3 * mLayout->innerCount);
     for (const RhsBlock& b : mAnchorBlocks)
       rhs.segment<3>(3 * b.row) -= b.block * boundaryMove.segment<3>(3 * b.slot);
   } else {

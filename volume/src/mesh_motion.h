@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -41,6 +42,9 @@ class MotionStiffness {
 
   /// K at `mesh`'s node positions; `mesh` has the tets this was made for.
   const SparseMatrix& assemble(const core::TetMesh& mesh);
+  /// The same into `into`, a matrix of matrix()'s sparsity (a copy of it): what a user that shares this
+  /// layout with others assembles into.
+  void assemble(const core::TetMesh& mesh, SparseMatrix& into) const;
   const SparseMatrix& matrix() const { return mK; }
   const NodeNeighbours& neighbours() const { return mNeighbours; }
   /// Index in matrix().valuePtr() of row 3u + i, column 3v + j; −1 when nodes u and v share no tet.
@@ -63,14 +67,34 @@ class MotionStiffness {
 /// and kept.
 class InteriorMotion {
  public:
+  /// What depends on the tets and the boundary alone: the mesh-motion stiffness's layout, the inner nodes'
+  /// numbering, K_ii's sparsity and where each tet's blocks go in it. Immutable once made: shared by the
+  /// motions of the same tets (volume::MorphPlan).
+  struct Layout {
+    Layout(const core::TetMesh& mesh, std::span<const char> isBoundary);
+    MotionStiffness stiffness;
+    std::vector<int> inner;         ///< per node: its index among the inner nodes, or −1
+    std::vector<int> boundarySlot;  ///< per node: its index among the boundary nodes, or −1
+    int innerCount = 0;
+    SparseMatrix kii;  ///< K_ii's sparsity (its values 0)
+    /// A tet with an inner node, and per pair (a, b) of its nodes, both inner: where K_ii's block of rows
+    /// a and columns b starts in kii's values (its column j is j lengths of b's K_ii columns further on);
+    /// −1 where a or b is on the boundary.
+    struct ActiveTet {
+      std::uint32_t tet;
+      std::array<Eigen::Index, 16> blockStart;
+    };
+    std::vector<ActiveTet> activeTets;
+  };
+
   /// `isBoundary[v]`: node v's displacement is given.
   InteriorMotion(const core::TetMesh& mesh, std::span<const char> isBoundary);
-  /// The same layout, to extend on its own (no factor is copied: the copy factorizes its own).
-  InteriorMotion(const InteriorMotion& other);
-  InteriorMotion& operator=(const InteriorMotion&) = delete;
+  /// On a layout made before (for the same tets and boundary), shared.
+  explicit InteriorMotion(std::shared_ptr<const Layout> layout);
 
+  const std::shared_ptr<const Layout>& layout() const { return mLayout; }
   /// The mesh-motion stiffness of the same tets, laid out (for others to assemble on them).
-  MotionStiffness& stiffness() { return mStiffness; }
+  const MotionStiffness& stiffness() const { return mLayout->stiffness; }
 
   /// Moves `mesh`'s boundary nodes by `boundaryMove` (3 per boundary node, ascending node order) and its
   /// inner nodes as the elastic body would. Errors when the system cannot be factorized.
@@ -95,19 +119,8 @@ class InteriorMotion {
   /// Moves the boundary nodes by `boundaryMove` and the inner ones by `inner`.
   void move(core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove, const Eigen::VectorXd& inner) const;
 
-  MotionStiffness mStiffness;
-  std::vector<int> mInner;         ///< per node: its index among the inner nodes, or −1
-  std::vector<int> mBoundarySlot;  ///< per node: its index among the boundary nodes, or −1
-  int mInnerCount = 0;
-  SparseMatrix mKii;
-  /// A tet with an inner node, and per pair (a, b) of its nodes, both inner: where K_ii's block of rows a
-  /// and columns b starts in mKii's values (its column j is j lengths of b's K_ii columns further on); −1
-  /// where a or b is on the boundary.
-  struct ActiveTet {
-    std::uint32_t tet;
-    std::array<Eigen::Index, 16> blockStart;
-  };
-  std::vector<ActiveTet> mActiveTets;
+  std::shared_ptr<const Layout> mLayout;
+  SparseMatrix mKii;  ///< the layout's kii, with this motion's values
   Eigen::SimplicialLDLT<SparseMatrix> mSolver;
   bool mAnalyzed = false;
   /// extendFromAnchor's: the positions it was factorized at, its factor, its right-hand side's blocks.

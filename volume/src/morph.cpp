@@ -101,11 +101,12 @@ std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh)
 /// boundary node, the target triangle its closest point was last found on (MorphTarget::kNoHint before
 /// the first search): each search starts from it, as a node moves little from round to round.
 void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTarget::View& target, int rounds,
-                         double minQuality, detail::MotionStiffness& stiffness,
+                         double minQuality, const detail::MotionStiffness& stiffness,
                          const detail::SymbolicFactor* analysis, std::vector<std::uint32_t>& nearest) {
   if (rounds <= 0) return;
   const TetMesh start = mesh;
-  const SparseMatrix k = stiffness.assemble(start);
+  SparseMatrix k = stiffness.matrix();
+  stiffness.assemble(start, k);
   const auto n = static_cast<Eigen::Index>(3 * mesh.nodeCount());
   const std::vector<double> nodeArea = boundaryAreas(boundary, start);
   // The target's side: up to 2,000 of its samples, each with its share of the target's area.
@@ -213,16 +214,18 @@ namespace detail {
 /// the morphs of those tets.
 struct MorphLayout {
   MorphLayout(const TetMesh& mesh, int registrationRounds)
-      : boundary(findBoundary(mesh)), isBoundary(mesh.nodeCount(), 0), motion(mesh, markBoundary()) {
+      : boundary(findBoundary(mesh)),
+        isBoundary(mesh.nodeCount(), 0),
+        motion(std::make_shared<const InteriorMotion::Layout>(mesh, markBoundary())) {
     if (registrationRounds > 0) {
       // The registration's system has K's sparsity (the fit couples nodes of one boundary face only).
-      const SparseMatrix& pattern = motion.stiffness().matrix();
+      const SparseMatrix& pattern = motion->stiffness.matrix();
       registration = SparseCholesky::analyze(pattern, nodeBlockOrder(pattern));
     }
   }
   Boundary boundary;
-  std::vector<char> isBoundary;  ///< per node
-  InteriorMotion motion;         ///< its layout, copied by each morph (which writes its values)
+  std::vector<char> isBoundary;                          ///< per node
+  std::shared_ptr<const InteriorMotion::Layout> motion;  ///< the interior's, shared by the morphs
   /// The analysis of the registration's system; null where not made.
   std::shared_ptr<const SymbolicFactor> registration;
 
@@ -379,7 +382,7 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
     if (options.plan) options.plan->mState->keep(mesh, layout);
   }
   const Boundary& boundary = layout->boundary;
-  detail::InteriorMotion motion = layout->motion;
+  detail::InteriorMotion motion(layout->motion);
   std::vector<std::uint32_t> nearest(boundary.nodes.size(), MorphTarget::kNoHint);
   registerElastically(out.mesh, boundary, target, options.registrationRounds, minQuality, motion.stiffness(),
                       layout->registration.get(), nearest);

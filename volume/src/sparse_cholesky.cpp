@@ -362,6 +362,8 @@ std::shared_ptr<const SymbolicFactor> SparseCholesky::analyze(const Eigen::Spars
   {
     const CallGuard guard;
     impl->factor = analyzeWith(matrix, order, impl->common);
+    // The analysis's workspace (a few integers per row) is not needed to keep it.
+    cholmod_free_work(&impl->common);
   }
   if (!impl->factor) return nullptr;
   impl->factorNonzeros = impl->common.lnz;
