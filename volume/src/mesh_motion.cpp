@@ -66,27 +66,6 @@ SparseMatrix meshMotionStiffness(const TetMesh& mesh) {
 }
 
 MotionStiffness::MotionStiffness(const TetMesh& mesh) : mNeighbours(nodeNeighbours(mesh)) {
-  // Column 3v + j holds rows 3u + i for every neighbour u of v (ascending) and i = 0, 1, 2: the three
-  // columns of a node have the same rows, and a node's three rows are consecutive.
-  const std::size_t nodes = mesh.nodeCount();
-  const auto n = static_cast<Eigen::Index>(3 * nodes);
-  mK.resize(n, n);
-  mK.resizeNonZeros(static_cast<Eigen::Index>(9 * mNeighbours.nodes.size()));
-  int* outer = mK.outerIndexPtr();
-  int* inner = mK.innerIndexPtr();
-  for (std::size_t v = 0; v < nodes; ++v) {
-    const std::uint32_t first = mNeighbours.start[v], degree = mNeighbours.start[v + 1] - first;
-    for (std::uint32_t j = 0; j < 3; ++j) {
-      const auto column = static_cast<int>(9 * first + 3 * j * degree);
-      outer[3 * v + j] = column;
-      for (std::uint32_t k = 0; k < degree; ++k)
-        for (std::uint32_t i = 0; i < 3; ++i)
-          inner[column + static_cast<int>(3 * k + i)] =
-              static_cast<int>(3 * mNeighbours.nodes[first + k] + i);
-    }
-  }
-  outer[n] = static_cast<int>(9 * mNeighbours.nodes.size());
-  std::fill_n(mK.valuePtr(), mK.nonZeros(), 0.0);
   mSlots.resize(mesh.tetCount());
   for (std::size_t t = 0; t < mesh.tetCount(); ++t)
     for (std::size_t a = 0; a < 4; ++a)
@@ -98,9 +77,34 @@ MotionStiffness::MotionStiffness(const TetMesh& mesh) : mNeighbours(nodeNeighbou
       }
 }
 
-const SparseMatrix& MotionStiffness::assemble(const TetMesh& mesh) {
-  assemble(mesh, mK);
-  return mK;
+SparseMatrix MotionStiffness::matrix() const {
+  // A node's three columns have the same rows, and a node's three rows are consecutive.
+  const std::size_t nodes = mNeighbours.start.size() - 1;
+  const auto n = static_cast<Eigen::Index>(3 * nodes);
+  SparseMatrix k(n, n);
+  k.resizeNonZeros(static_cast<Eigen::Index>(9 * mNeighbours.nodes.size()));
+  int* outer = k.outerIndexPtr();
+  int* inner = k.innerIndexPtr();
+  for (std::uint32_t v = 0; v < nodes; ++v) {
+    const std::uint32_t first = mNeighbours.start[v], degree = mNeighbours.start[v + 1] - first;
+    for (int j = 0; j < 3; ++j) {
+      const auto column = static_cast<int>(columnStart(v, j));
+      outer[3 * v + static_cast<std::uint32_t>(j)] = column;
+      for (std::uint32_t u = 0; u < degree; ++u)
+        for (std::uint32_t i = 0; i < 3; ++i)
+          inner[column + static_cast<int>(3 * u + i)] =
+              static_cast<int>(3 * mNeighbours.nodes[first + u] + i);
+    }
+  }
+  outer[n] = static_cast<int>(9 * mNeighbours.nodes.size());
+  std::fill_n(k.valuePtr(), k.nonZeros(), 0.0);
+  return k;
+}
+
+SparseMatrix MotionStiffness::assemble(const TetMesh& mesh) const {
+  SparseMatrix k = matrix();
+  assemble(mesh, k);
+  return k;
 }
 
 void MotionStiffness::assemble(const TetMesh& mesh, SparseMatrix& into) const {
@@ -124,14 +128,14 @@ Eigen::Index MotionStiffness::valueIndex(std::uint32_t u, std::uint32_t v, int i
              end = mNeighbours.nodes.begin() + mNeighbours.start[v + 1];
   const auto at = std::lower_bound(begin, end, u);
   if (at == end || *at != u) return -1;
-  return mK.outerIndexPtr()[3 * v + static_cast<std::uint32_t>(j)] + 3 * (at - begin) + i;
+  return columnStart(v, j) + 3 * (at - begin) + i;
 }
 
 std::array<Eigen::Index, 3> MotionStiffness::diagonalIndices(std::uint32_t u, std::uint32_t v) const {
   const Eigen::Index first = valueIndex(u, v, 0, 0);
   if (first < 0) return {-1, -1, -1};
-  const int* outer = mK.outerIndexPtr() + 3 * v;
-  return {first, first - outer[0] + outer[1] + 1, first - outer[0] + outer[2] + 2};
+  return {first, first - columnStart(v, 0) + columnStart(v, 1) + 1,
+          first - columnStart(v, 0) + columnStart(v, 2) + 2};
 }
 
 InteriorMotion::Layout::Layout(const TetMesh& mesh, std::span<const char> isBoundary) : stiffness(mesh) {
@@ -148,10 +152,9 @@ InteriorMotion::Layout::Layout(const TetMesh& mesh, std::span<const char> isBoun
   if (innerCount == 0) return;
   // K_ii: K's rows and columns of the inner nodes. Inner nodes are numbered in the mesh's order, so each
   // column's rows stay ascending, and a node's three columns have the same rows, as in K.
-  const SparseMatrix& k = stiffness.matrix();
-  std::vector<Eigen::Index> toInner(static_cast<std::size_t>(k.nonZeros()), -1);  // K's value → K_ii's
-  kii.resize(3 * innerCount, 3 * innerCount);
-  std::vector<int> outer(static_cast<std::size_t>(3 * innerCount) + 1, 0), rows;
+  const SparseMatrix k = stiffness.matrix();
+  std::vector<int> toInner(static_cast<std::size_t>(k.nonZeros()), -1);  // K's value → K_ii's
+  kiiOuter.assign(static_cast<std::size_t>(3 * innerCount) + 1, 0);
   for (Eigen::Index col = 0; col < k.outerSize(); ++col) {
     const int v = inner[static_cast<std::size_t>(col / 3)];
     if (v < 0) continue;
@@ -159,15 +162,11 @@ InteriorMotion::Layout::Layout(const TetMesh& mesh, std::span<const char> isBoun
     for (Eigen::Index at = k.outerIndexPtr()[col]; at < k.outerIndexPtr()[col + 1]; ++at) {
       const int row = k.innerIndexPtr()[at], u = inner[static_cast<std::size_t>(row / 3)];
       if (u < 0) continue;
-      toInner[static_cast<std::size_t>(at)] = static_cast<Eigen::Index>(rows.size());
-      rows.push_back(3 * u + row % 3);
+      toInner[static_cast<std::size_t>(at)] = static_cast<int>(kiiInner.size());
+      kiiInner.push_back(3 * u + row % 3);
     }
-    outer[innerCol + 1] = static_cast<int>(rows.size());
+    kiiOuter[innerCol + 1] = static_cast<int>(kiiInner.size());
   }
-  kii.resizeNonZeros(static_cast<Eigen::Index>(rows.size()));
-  std::copy(outer.begin(), outer.end(), kii.outerIndexPtr());
-  std::copy(rows.begin(), rows.end(), kii.innerIndexPtr());
-  std::fill_n(kii.valuePtr(), kii.nonZeros(), 0.0);
   for (std::size_t t = 0; t < mesh.tetCount(); ++t) {
     const auto& tet = mesh.tets[t];
     if (std::none_of(tet.begin(), tet.end(), [&](std::uint32_t v) { return inner[v] >= 0; })) continue;
@@ -185,8 +184,14 @@ InteriorMotion::Layout::Layout(const TetMesh& mesh, std::span<const char> isBoun
 InteriorMotion::InteriorMotion(const TetMesh& mesh, std::span<const char> isBoundary)
     : InteriorMotion(std::make_shared<const Layout>(mesh, isBoundary)) {}
 
-InteriorMotion::InteriorMotion(std::shared_ptr<const Layout> layout)
-    : mLayout(std::move(layout)), mKii(mLayout->kii) {}
+InteriorMotion::InteriorMotion(std::shared_ptr<const Layout> layout) : mLayout(std::move(layout)) {
+  const Layout& l = *mLayout;
+  mKii.resize(3 * l.innerCount, 3 * l.innerCount);
+  mKii.resizeNonZeros(static_cast<Eigen::Index>(l.kiiInner.size()));
+  std::copy(l.kiiOuter.begin(), l.kiiOuter.end(), mKii.outerIndexPtr());
+  std::copy(l.kiiInner.begin(), l.kiiInner.end(), mKii.innerIndexPtr());
+  std::fill_n(mKii.valuePtr(), mKii.nonZeros(), 0.0);
+}
 
 Eigen::VectorXd InteriorMotion::assemble(const TetMesh& mesh, const Eigen::VectorXd& boundaryMove,
                                          std::vector<RhsBlock>* blocks) {

@@ -35,17 +35,19 @@ NodeNeighbours nodeNeighbours(const core::TetMesh& mesh);
 SparseMatrix meshMotionStiffness(const core::TetMesh& mesh);
 
 /// meshMotionStiffness with its sparsity laid out once for a mesh's tets: assemble() on the nodes' current
-/// positions writes values only (the same values, summed in another order).
+/// positions writes values only (the same values, summed in another order). Holds the layout alone (the
+/// nodes' neighbours and where each tet's blocks go), a few bytes per tet: kept beside a database entry
+/// (volume::MorphPlan) and shared by its morphs, each assembling into a matrix of its own.
 class MotionStiffness {
  public:
   explicit MotionStiffness(const core::TetMesh& mesh);
 
+  /// A new matrix of K's sparsity, its values 0.
+  SparseMatrix matrix() const;
   /// K at `mesh`'s node positions; `mesh` has the tets this was made for.
-  const SparseMatrix& assemble(const core::TetMesh& mesh);
-  /// The same into `into`, a matrix of matrix()'s sparsity (a copy of it): what a user that shares this
-  /// layout with others assembles into.
+  SparseMatrix assemble(const core::TetMesh& mesh) const;
+  /// The same into `into`, a matrix of K's sparsity (matrix()), its values overwritten.
   void assemble(const core::TetMesh& mesh, SparseMatrix& into) const;
-  const SparseMatrix& matrix() const { return mK; }
   const NodeNeighbours& neighbours() const { return mNeighbours; }
   /// Index in matrix().valuePtr() of row 3u + i, column 3v + j; −1 when nodes u and v share no tet.
   Eigen::Index valueIndex(std::uint32_t u, std::uint32_t v, int i, int j) const;
@@ -53,8 +55,13 @@ class MotionStiffness {
   std::array<Eigen::Index, 3> diagonalIndices(std::uint32_t u, std::uint32_t v) const;
 
  private:
+  /// Where column 3v + j starts among K's values: column 3v + j holds rows 3u + i for every neighbour u of
+  /// v (ascending) and i = 0, 1, 2.
+  Eigen::Index columnStart(std::uint32_t v, int j) const {
+    const std::uint32_t first = mNeighbours.start[v], degree = mNeighbours.start[v + 1] - first;
+    return static_cast<Eigen::Index>(9 * first + 3 * static_cast<std::uint32_t>(j) * degree);
+  }
   NodeNeighbours mNeighbours;
-  SparseMatrix mK;
   /// Per tet, per (a, b): where node a sits among node b's neighbours.
   std::vector<std::array<std::uint32_t, 16>> mSlots;
 };
@@ -76,13 +83,13 @@ class InteriorMotion {
     std::vector<int> inner;         ///< per node: its index among the inner nodes, or −1
     std::vector<int> boundarySlot;  ///< per node: its index among the boundary nodes, or −1
     int innerCount = 0;
-    SparseMatrix kii;  ///< K_ii's sparsity (its values 0)
+    std::vector<int> kiiOuter, kiiInner;  ///< K_ii's sparsity (compressed columns)
     /// A tet with an inner node, and per pair (a, b) of its nodes, both inner: where K_ii's block of rows
-    /// a and columns b starts in kii's values (its column j is j lengths of b's K_ii columns further on);
+    /// a and columns b starts in K_ii's values (its column j is j lengths of b's K_ii columns further on);
     /// −1 where a or b is on the boundary.
     struct ActiveTet {
       std::uint32_t tet;
-      std::array<Eigen::Index, 16> blockStart;
+      std::array<int, 16> blockStart;
     };
     std::vector<ActiveTet> activeTets;
   };
@@ -120,7 +127,7 @@ class InteriorMotion {
   void move(core::TetMesh& mesh, const Eigen::VectorXd& boundaryMove, const Eigen::VectorXd& inner) const;
 
   std::shared_ptr<const Layout> mLayout;
-  SparseMatrix mKii;  ///< the layout's kii, with this motion's values
+  SparseMatrix mKii;  ///< K_ii of the layout's sparsity, with this motion's values
   Eigen::SimplicialLDLT<SparseMatrix> mSolver;
   bool mAnalyzed = false;
   /// extendFromAnchor's: the positions it was factorized at, its factor, its right-hand side's blocks.
