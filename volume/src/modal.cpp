@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +15,7 @@
 
 #include <shapedb/volume/modal.h>
 
+#include "kept_for_tets.h"
 #include "sparse_cholesky.h"
 #include "sparse_products.h"
 
@@ -23,35 +23,8 @@ namespace shapedb::volume {
 
 namespace detail {
 
-/// A ModalPlan's analysis and the connectivity it is of.
-struct ModalPlanState {
-  /// The analysis, where it is of `mesh`'s tets in `order`; null otherwise.
-  std::shared_ptr<const SymbolicFactor> find(const core::TetMesh& mesh, ElementOrder order) const {
-    const std::lock_guard lock(mutex);
-    return analysis && order == elementOrder && mesh.nodeCount() == nodeCount && mesh.tets == tets ? analysis
-                                                                                                   : nullptr;
-  }
-  /// Keeps `made`, the analysis of `mesh`'s tets in `order`, unless it holds one already.
-  void keep(const core::TetMesh& mesh, ElementOrder order, std::shared_ptr<const SymbolicFactor> made) {
-    const std::lock_guard lock(mutex);
-    if (analysis) return;
-    tets = mesh.tets;
-    nodeCount = mesh.nodeCount();
-    elementOrder = order;
-    analysis = std::move(made);
-  }
-  bool ready() const {
-    const std::lock_guard lock(mutex);
-    return analysis != nullptr;
-  }
-
- private:
-  mutable std::mutex mutex;
-  std::vector<core::TetMesh::Tet> tets;
-  std::size_t nodeCount = 0;
-  ElementOrder elementOrder = ElementOrder::kQuadratic;
-  std::shared_ptr<const SymbolicFactor> analysis;
-};
+/// A ModalPlan's analysis, kept for the tets and element order (the variant) it is of.
+struct ModalPlanState : KeptForTets<SymbolicFactor> {};
 
 }  // namespace detail
 
@@ -171,12 +144,13 @@ class SymmetricShiftInvert {
   /// plan keeps, where there is a plan).
   bool factorizeShifted(const PlanSlot& slot) {
     if (!slot.plan) return mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
-    std::shared_ptr<const detail::SymbolicFactor> analysis = slot.plan->find(*slot.mesh, slot.order);
+    std::shared_ptr<const detail::SymbolicFactor> analysis =
+        slot.plan->find(*slot.mesh, static_cast<int>(slot.order));
     if (!analysis) {
       analysis = detail::SparseCholesky::analyze(mShifted, detail::nodeBlockOrder(mShifted));
       // Where even the analysis fails, factorize says why.
       if (!analysis) return mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
-      slot.plan->keep(*slot.mesh, slot.order, analysis);
+      slot.plan->keep(*slot.mesh, analysis, static_cast<int>(slot.order));
     }
     return mSolver.factorize(mShifted, *analysis);
   }

@@ -2,7 +2,6 @@
 #include <array>
 #include <cmath>
 #include <memory>
-#include <mutex>
 #include <span>
 #include <string>
 #include <vector>
@@ -13,6 +12,7 @@
 #include <shapedb/core/spatial.h>
 #include <shapedb/volume/morph.h>
 
+#include "kept_for_tets.h"
 #include "mesh_motion.h"
 #include "sparse_cholesky.h"
 
@@ -237,32 +237,8 @@ struct MorphLayout {
   }
 };
 
-/// A MorphPlan's layout and the connectivity it is of.
-struct MorphPlanState {
-  /// The layout, where it is of `mesh`'s tets; null otherwise.
-  std::shared_ptr<const MorphLayout> find(const TetMesh& mesh) const {
-    const std::lock_guard lock(mutex);
-    return layout && mesh.nodeCount() == nodeCount && mesh.tets == tets ? layout : nullptr;
-  }
-  /// Keeps `made`, the layout of `mesh`'s tets, unless it holds one already.
-  void keep(const TetMesh& mesh, std::shared_ptr<const MorphLayout> made) {
-    const std::lock_guard lock(mutex);
-    if (layout) return;
-    tets = mesh.tets;
-    nodeCount = mesh.nodeCount();
-    layout = std::move(made);
-  }
-  bool ready() const {
-    const std::lock_guard lock(mutex);
-    return layout != nullptr;
-  }
-
- private:
-  mutable std::mutex mutex;
-  std::vector<TetMesh::Tet> tets;
-  std::size_t nodeCount = 0;
-  std::shared_ptr<const MorphLayout> layout;
-};
+/// A MorphPlan's layout, kept for the tets it is of.
+struct MorphPlanState : KeptForTets<MorphLayout> {};
 
 }  // namespace detail
 
