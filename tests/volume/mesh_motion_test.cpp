@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <array>
+#include <numeric>
 #include <random>
+#include <set>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -77,6 +79,35 @@ TEST(MeshMotion, TheLaidOutStiffnessIsTheTripletOneWhereverTheNodesMove) {
   }
   EXPECT_GT(apart, 0);
   EXPECT_GT(shared, 0);
+}
+
+TEST(MeshMotion, NodeNeighboursAreTheNodesThatShareATet) {
+  // Against the plain definition, on a mesh's tets renumbered at random (the lists must not depend on the
+  // numbering being the mesher's) and with an unused node.
+  const TetMesh start = ellipsoidTets();
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 3; ++trial) {
+    TetMesh mesh = start;
+    std::vector<std::uint32_t> renumber(mesh.nodeCount() + 1);
+    std::iota(renumber.begin(), renumber.end(), 0u);
+    std::shuffle(renumber.begin(), renumber.end(), rng);
+    mesh.nodes.push_back(Vec3::Zero());
+    for (auto& tet : mesh.tets)
+      for (std::uint32_t& v : tet)
+        v = renumber[v];
+    std::shuffle(mesh.tets.begin(), mesh.tets.end(), rng);
+    std::vector<std::set<std::uint32_t>> expected(mesh.nodeCount());
+    for (const auto& tet : mesh.tets)
+      for (std::uint32_t a : tet)
+        expected[a].insert(tet.begin(), tet.end());
+    const NodeNeighbours got = nodeNeighbours(mesh);
+    ASSERT_EQ(got.start.size(), mesh.nodeCount() + 1);
+    for (std::uint32_t v = 0; v < mesh.nodeCount(); ++v)
+      EXPECT_EQ(
+          std::vector<std::uint32_t>(got.nodes.begin() + got.start[v], got.nodes.begin() + got.start[v + 1]),
+          std::vector<std::uint32_t>(expected[v].begin(), expected[v].end()))
+          << "trial " << trial << ", node " << v;
+  }
 }
 
 TEST(MeshMotion, TheInteriorFollowsAsADenseSolveSaysCallAfterCall) {
