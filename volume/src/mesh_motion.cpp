@@ -1,7 +1,6 @@
 #include "mesh_motion.h"
 
 #include <algorithm>
-#include <limits>
 
 namespace shapedb::volume::detail {
 namespace {
@@ -28,44 +27,6 @@ void forEachElementBlock(const TetMesh& mesh, std::size_t t, Sink&& sink) {
 
 }  // namespace
 
-NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
-  // Each node's tets (by counting), then the nodes of those, each marked once, sorted node by node: a node
-  // has a few dozen neighbours, and sorting each one's list cost less than sorting the sixteen pairs of
-  // every tet at once.
-  const std::size_t n = mesh.nodeCount();
-  std::vector<std::uint32_t> tetsAt(n + 1, 0);
-  for (const auto& tet : mesh.tets)
-    for (std::uint32_t a : tet)
-      ++tetsAt[a + 1];
-  for (std::size_t i = 0; i < n; ++i)
-    tetsAt[i + 1] += tetsAt[i];
-  std::vector<std::uint32_t> incident(tetsAt[n]);
-  {
-    std::vector<std::uint32_t> next(tetsAt.begin(), tetsAt.end() - 1);
-    for (std::size_t t = 0; t < mesh.tetCount(); ++t)
-      for (std::uint32_t a : mesh.tets[t])
-        incident[next[a]++] = static_cast<std::uint32_t>(t);
-  }
-  constexpr std::uint32_t kUnmarked = std::numeric_limits<std::uint32_t>::max();
-  std::vector<std::uint32_t> markedBy(n, kUnmarked);
-  NodeNeighbours out;
-  out.start.assign(n + 1, 0);
-  out.nodes.reserve(4 * static_cast<std::size_t>(tetsAt[n]));
-  for (std::uint32_t b = 0; b < n; ++b) {
-    const std::size_t first = out.nodes.size();
-    for (std::uint32_t k = tetsAt[b]; k < tetsAt[b + 1]; ++k)
-      for (std::uint32_t a : mesh.tets[incident[k]])
-        if (markedBy[a] != b) {
-          markedBy[a] = b;
-          out.nodes.push_back(a);
-        }
-    std::sort(out.nodes.begin() + static_cast<std::ptrdiff_t>(first), out.nodes.end());
-    out.start[b + 1] = static_cast<std::uint32_t>(out.nodes.size());
-  }
-  out.nodes.shrink_to_fit();  // kept beside a database entry (volume::MorphPlan)
-  return out;
-}
-
 SparseMatrix meshMotionStiffness(const TetMesh& mesh) {
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(144 * mesh.tetCount());
@@ -84,6 +45,7 @@ SparseMatrix meshMotionStiffness(const TetMesh& mesh) {
 }
 
 MotionStiffness::MotionStiffness(const TetMesh& mesh) : mNeighbours(nodeNeighbours(mesh)) {
+  mNeighbours.nodes.shrink_to_fit();  // kept beside a database entry (volume::MorphPlan)
   mSlots.resize(mesh.tetCount());
   for (std::size_t t = 0; t < mesh.tetCount(); ++t)
     for (std::size_t a = 0; a < 4; ++a)

@@ -17,16 +17,16 @@
 #include <shapedb/core/physics.h>
 #include <shapedb/core/result.h>
 
+#include "node_neighbours.h"
+
 namespace shapedb::volume::detail {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-/// Per node of a tet mesh, the nodes that share a tet with it, itself included, ascending (CSR).
-struct NodeNeighbours {
-  std::vector<std::uint32_t> start;
-  std::vector<std::uint32_t> nodes;
-};
-NodeNeighbours nodeNeighbours(const core::TetMesh& mesh);
+/// Per node of a tet mesh, the nodes that share a tet with it, itself included, ascending.
+inline NodeNeighbours nodeNeighbours(const core::TetMesh& mesh) {
+  return nodeNeighbours(mesh.nodeCount(), mesh.tets);
+}
 
 /// Stiffness of the linear elastic body that carries a boundary displacement inwards (ν = 0.3,
 /// constant-strain tets), each tet's modulus 1/V_t so that small tets, which a given displacement would

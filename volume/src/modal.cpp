@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +15,7 @@
 #include <shapedb/volume/modal.h>
 
 #include "kept_for_tets.h"
+#include "node_neighbours.h"
 #include "sparse_cholesky.h"
 #include "sparse_products.h"
 
@@ -463,38 +463,9 @@ class Assembler {
   using Element = std::array<std::uint32_t, N>;
 
   Assembler(std::size_t nodeCount, const std::vector<Element>& elements) {
-    // Node adjacency (each node with itself too), CSR with sorted neighbours: each node's elements (by
-    // counting), the nodes of those marked once each, then sorted. Sorting every node pair of every
-    // element at once instead cost a few percent of a correction's modes.
-    std::vector<std::size_t> elementsAt(nodeCount + 1, 0);
-    for (const Element& e : elements)
-      for (std::uint32_t a : e)
-        ++elementsAt[a + 1];
-    for (std::size_t i = 0; i < nodeCount; ++i)
-      elementsAt[i + 1] += elementsAt[i];
-    std::vector<std::uint32_t> incident(elementsAt[nodeCount]);
-    {
-      std::vector<std::size_t> next(elementsAt.begin(), elementsAt.end() - 1);
-      for (std::size_t i = 0; i < elements.size(); ++i)
-        for (std::uint32_t a : elements[i])
-          incident[next[a]++] = static_cast<std::uint32_t>(i);
-    }
-    constexpr std::uint32_t kUnmarked = std::numeric_limits<std::uint32_t>::max();
-    std::vector<std::uint32_t> markedBy(nodeCount, kUnmarked);
-    mStart.assign(nodeCount + 1, 0);
-    mNeighbours.reserve(elementsAt[nodeCount] * N / 4);
-    for (std::size_t b = 0; b < nodeCount; ++b) {
-      const std::size_t first = mNeighbours.size();
-      for (std::size_t k = elementsAt[b]; k < elementsAt[b + 1]; ++k)
-        for (std::uint32_t a : elements[incident[k]])
-          if (markedBy[a] != b) {
-            markedBy[a] = static_cast<std::uint32_t>(b);
-            mNeighbours.push_back(a);
-          }
-      std::sort(mNeighbours.begin() + static_cast<std::ptrdiff_t>(first), mNeighbours.end());
-      mStart[b + 1] = mNeighbours.size();
-    }
-    const std::size_t pairCount = mNeighbours.size();
+    // Node adjacency (each node with itself too), CSR with sorted neighbours.
+    mAdjacency = detail::nodeNeighbours(nodeCount, elements);
+    const std::size_t pairCount = mAdjacency.nodes.size();
     // K's column 3b + c: rows 3a, 3a + 1, 3a + 2 for every neighbour a of b. M's 3 × 3 blocks are
     // diagonal (the same scalar mass on each axis): its column 3b + c has row 3a + c only.
     const auto n = static_cast<Eigen::Index>(3 * nodeCount);
@@ -505,14 +476,14 @@ class Assembler {
     m.resize(n, n);
     m.resizeNonZeros(static_cast<Eigen::Index>(3 * pairCount));
     for (std::size_t b = 0; b < nodeCount; ++b) {
-      const std::size_t degree = mStart[b + 1] - mStart[b];
+      const std::size_t degree = start(b + 1) - start(b);
       for (std::size_t c = 0; c < 3; ++c) {
-        const std::size_t column = 3 * b + c, first = 9 * mStart[b] + 3 * degree * c,
-                          firstMass = 3 * mStart[b] + degree * c;
+        const std::size_t column = 3 * b + c, first = 9 * start(b) + 3 * degree * c,
+                          firstMass = 3 * start(b) + degree * c;
         k.outerIndexPtr()[column] = static_cast<int>(first);
         m.outerIndexPtr()[column] = static_cast<int>(firstMass);
         for (std::size_t j = 0; j < degree; ++j) {
-          const std::uint32_t a = mNeighbours[mStart[b] + j];
+          const std::uint32_t a = mAdjacency.nodes[start(b) + j];
           for (std::size_t r = 0; r < 3; ++r)
             k.innerIndexPtr()[first + 3 * j + r] = static_cast<int>(3 * a + r);
           m.innerIndexPtr()[firstMass + j] = static_cast<int>(3 * a + c);
@@ -532,17 +503,17 @@ class Assembler {
     double* m = mMatrices.mass.valuePtr();
     for (std::size_t j = 0; j < N; ++j) {
       const std::uint32_t b = e[j];
-      const auto begin = mNeighbours.begin() + static_cast<std::ptrdiff_t>(mStart[b]);
-      const auto end = mNeighbours.begin() + static_cast<std::ptrdiff_t>(mStart[b + 1]);
-      const std::size_t degree = mStart[b + 1] - mStart[b];
+      const auto begin = mAdjacency.nodes.begin() + static_cast<std::ptrdiff_t>(start(b));
+      const auto end = mAdjacency.nodes.begin() + static_cast<std::ptrdiff_t>(start(b + 1));
+      const std::size_t degree = start(b + 1) - start(b);
       for (std::size_t i = 0; i < N; ++i) {
         const auto slot = static_cast<std::size_t>(std::lower_bound(begin, end, e[i]) - begin);
         const double mass = scalarMass(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
         for (std::size_t c = 0; c < 3; ++c) {
-          const std::size_t at = 9 * mStart[b] + 3 * degree * c + 3 * slot;
+          const std::size_t at = 9 * start(b) + 3 * degree * c + 3 * slot;
           for (std::size_t r = 0; r < 3; ++r)
             k[at + r] += ke(static_cast<Eigen::Index>(3 * i + r), static_cast<Eigen::Index>(3 * j + c));
-          m[3 * mStart[b] + degree * c + slot] += mass;
+          m[3 * start(b) + degree * c + slot] += mass;
         }
       }
     }
@@ -558,8 +529,9 @@ class Assembler {
   }
 
  private:
-  std::vector<std::size_t> mStart;
-  std::vector<std::uint32_t> mNeighbours;
+  /// Where node b's neighbours start among mAdjacency.nodes (and its K and M columns among the values).
+  std::size_t start(std::size_t b) const { return mAdjacency.start[b]; }
+  detail::NodeNeighbours mAdjacency;
   FemMatrices mMatrices;
 };
 
