@@ -147,9 +147,10 @@ class SymmetricShiftInvert {
     std::shared_ptr<const detail::SymbolicFactor> analysis =
         slot.plan->find(*slot.mesh, static_cast<int>(slot.order));
     if (!analysis) {
-      analysis = detail::SparseCholesky::analyze(mShifted, detail::nodeBlockOrder(mShifted));
+      const std::vector<int> order = detail::nodeBlockOrder(mShifted);
+      analysis = detail::SparseCholesky::analyze(mShifted, order);
       // Where even the analysis fails, factorize says why.
-      if (!analysis) return mSolver.factorize(mShifted, detail::nodeBlockOrder(mShifted));
+      if (!analysis) return mSolver.factorize(mShifted, order);
       slot.plan->keep(*slot.mesh, analysis, static_cast<int>(slot.order));
     }
     return mSolver.factorize(mShifted, *analysis);

@@ -99,7 +99,8 @@ std::vector<double> boundaryAreas(const Boundary& boundary, const TetMesh& mesh)
 /// stiffness of the start configuration, w growing round by round. A round whose displacement would push a
 /// tet under `minQuality` is taken in part (halved up to three times) or not at all. `nearest` holds, per
 /// boundary node, the target triangle its closest point was last found on (MorphTarget::kNoHint before
-/// the first search): each search starts from it, as a node moves little from round to round.
+/// the first search): each search starts from it, as a node moves little from round to round. `analysis` is
+/// the symbolic analysis of K's sparsity (MorphLayout's); without one there is no registration.
 void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTarget::View& target, int rounds,
                          double minQuality, const detail::MotionStiffness& stiffness,
                          const detail::SymbolicFactor* analysis, std::vector<std::uint32_t>& nearest) {
@@ -117,10 +118,9 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
     stiffnessScale += k.coeff(i, i);
   for (double a : nodeArea)
     fitScale += 3.0 * a;
-  // CHOLMOD's factor, in a node-block order worked out once (or kept, `analysis`): K's sparsity holds the
-  // fit's.
+  // CHOLMOD's factor, on the layout's analysis (a node-block order worked out once): K's sparsity holds
+  // the fit's.
   detail::SparseCholesky solver;
-  const std::vector<int> order = analysis ? std::vector<int>() : detail::nodeBlockOrder(k);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(n);
   SparseMatrix a = k;
   // Per target point, the boundary face its closest point was last found on: the faces keep their
@@ -182,10 +182,7 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
     }
     if (!inPattern) break;  // cannot be: two nodes of a boundary face share its tet
     // Every round's A has K's sparsity: the first round's analysis serves them all.
-    const bool factorized = round > 0  ? solver.refactorize(a)
-                            : analysis ? solver.factorize(a, *analysis)
-                                       : solver.factorize(a, order);
-    if (!factorized) break;
+    if (!(round > 0 ? solver.refactorize(a) : analysis && solver.factorize(a, *analysis))) break;
     // The fit terms hold the start configuration's rigid motions, so the system is definite.
     Eigen::VectorXd next(n);
     if (!solver.solve(rhs.data(), next.data())) break;
@@ -210,31 +207,30 @@ void registerElastically(TetMesh& mesh, const Boundary& boundary, const MorphTar
 
 namespace detail {
 
+/// Per node of a mesh of `nodeCount` nodes, whether it is one of `boundary`'s.
+std::vector<char> boundaryMask(const Boundary& boundary, std::size_t nodeCount) {
+  std::vector<char> mask(nodeCount, 0);
+  for (std::uint32_t node : boundary.nodes)
+    mask[node] = 1;
+  return mask;
+}
+
 /// What morphTetMesh works out from the tets' connectivity alone (MorphPlan): immutable once made, shared by
 /// the morphs of those tets.
 struct MorphLayout {
-  MorphLayout(const TetMesh& mesh, int registrationRounds)
+  explicit MorphLayout(const TetMesh& mesh)
       : boundary(findBoundary(mesh)),
-        isBoundary(mesh.nodeCount(), 0),
-        motion(std::make_shared<const InteriorMotion::Layout>(mesh, markBoundary())) {
-    if (registrationRounds > 0) {
-      // The registration's system has K's sparsity (the fit couples nodes of one boundary face only).
-      const SparseMatrix& pattern = motion->stiffness.matrix();
-      registration = SparseCholesky::analyze(pattern, nodeBlockOrder(pattern));
-    }
+        motion(
+            std::make_shared<const InteriorMotion::Layout>(mesh, boundaryMask(boundary, mesh.nodeCount()))) {
+    // The registration's system has K's sparsity (the fit couples nodes of one boundary face only).
+    const SparseMatrix pattern = motion->stiffness.matrix();
+    registration = SparseCholesky::analyze(pattern, nodeBlockOrder(pattern));
   }
   Boundary boundary;
-  std::vector<char> isBoundary;                          ///< per node
   std::shared_ptr<const InteriorMotion::Layout> motion;  ///< the interior's, shared by the morphs
-  /// The analysis of the registration's system; null where not made.
+  /// The analysis of the registration's system; null where it failed (out of memory), and with it the
+  /// registration.
   std::shared_ptr<const SymbolicFactor> registration;
-
- private:
-  const std::vector<char>& markBoundary() {
-    for (std::uint32_t node : boundary.nodes)
-      isBoundary[node] = 1;
-    return isBoundary;
-  }
 };
 
 /// A MorphPlan's layout, kept for the tets it is of.
@@ -354,7 +350,7 @@ Result<MorphResult> morphTetMesh(const TetMesh& mesh, const MorphTarget::View& t
   std::shared_ptr<const detail::MorphLayout> layout =
       options.plan ? options.plan->mState->find(mesh) : nullptr;
   if (!layout) {
-    layout = std::make_shared<const detail::MorphLayout>(mesh, options.registrationRounds);
+    layout = std::make_shared<const detail::MorphLayout>(mesh);
     if (options.plan) options.plan->mState->keep(mesh, layout);
   }
   const Boundary& boundary = layout->boundary;
