@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <shapedb/bench/evaluation.h>
@@ -30,6 +31,7 @@ struct BenchCommandOptions {
   std::string out;
   MaterialFlags material;
   std::string directElements = "quadratic";
+  bool noWarmUp = false;
   bench::EvaluationOptions evaluation;
 };
 
@@ -83,9 +85,21 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
     return kExitInputError;
   }
 
+  // The warm-up's instance: a cache of its own, so that the timed queries find no entry fetched or planned.
+  std::optional<io::Database> warmUp;
+  if (!o.noWarmUp) {
+    Result<io::Database> opened = io::Database::open(o.database);
+    if (!opened) {
+      printError(opened.error().message);
+      return kExitInputError;
+    }
+    warmUp.emplace(std::move(opened).value());
+    o.evaluation.warmUp = &*warmUp;
+  }
+
   const auto start = std::chrono::steady_clock::now();
-  std::fprintf(stderr, "bench: %zu shapes: 5 queries each, then the direct computations...\n",
-               shapes->size());
+  std::fprintf(stderr, "bench: %zu shapes: %s6 queries each, then the direct computations...\n",
+               shapes->size(), o.noWarmUp ? "" : "a warm-up round, then ");
   o.evaluation.progress = [start](std::size_t done, std::size_t total, const std::string& name) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "bench: %zu/%zu direct computations done (%s), %.0f s\n", done, total, name.c_str(),
@@ -114,7 +128,8 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
       std::string("x smaller than the entries'") +
       (o.evaluation.correctionCandidates == io::QueryOptions{}.correctionCandidates
            ? std::string()
-           : "; the correction morphs " + std::to_string(o.evaluation.correctionCandidates) + " candidates");
+           : "; the correction morphs " + std::to_string(o.evaluation.correctionCandidates) + " candidates") +
+      (o.noWarmUp ? "; queries timed in a cold process (--no-warm-up)" : "");
   for (Status st : {bench::writeEvaluationCsv(*evaluations, out / "evaluation.csv"),
                     bench::writeEvaluationSummary(*evaluations, title, out / "summary.md"),
                     bench::writeEvaluationPlots(*evaluations, out)})
@@ -145,8 +160,11 @@ Command addBenchCommand(CLI::App& parent) {
       "geometry correction): the relative error\n"
       "of the first non-rigid frequencies, the volume IoU of the collision proxy with the shape, the query\n"
       "time and its speedup over the direct computation; beside two baselines, the solid ellipsoid and box\n"
-      "with the shape's mass and principal moments. Writes evaluation.csv, summary.md (printed too),\n"
-      "time.png and error.png in --out. Exit status 1 if no shape could be evaluated.");
+      "with the shape's mass and principal moments. The queries are timed one at a time, after a round of\n"
+      "them all, untimed, on another instance of the database (its own cache): a warm process, whose\n"
+      "first shapes do not pay for its start, and entries that the timed instance has not yet fetched or\n"
+      "planned a correction for. Writes evaluation.csv, summary.md (printed too), time.png and error.png in\n"
+      "--out. Exit status 1 if no shape could be evaluated.");
   app->add_option("DB", o->database, "Database file (from shapedb build)")->required();
   CLI::Option* queries = app->add_option(
       "--queries", o->queries,
@@ -183,6 +201,10 @@ Command addBenchCommand(CLI::App& parent) {
                   "from (as query --correct-candidates)")
       ->capture_default_str()
       ->check(CLI::Range(1, io::kMaxCorrectionCandidates));
+  app->add_flag(
+      "--no-warm-up", o->noWarmUp,
+      "Time the queries without the warm-up round: the first shapes then pay for the process's start\n"
+      "(its heap, threads and libraries)");
   app->add_option("--threads", o->evaluation.threads, "Threads for the direct computations (0: all cores)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

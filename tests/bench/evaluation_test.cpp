@@ -202,5 +202,61 @@ TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
     EXPECT_EQ(fields[i], fields[0]) << "row " << i;
 }
 
+TEST(Evaluation, TheWarmUpRunsOnAnInstanceOfItsOwnAndChangesNoAnswer) {
+  test::ScratchDir dir("evaluation-warm-up");
+  const auto path = dir / "small.db";
+  io::BuildOptions build;
+  build.parameters.entries = 4;
+  build.parameters.families = {volume::Family::kBox};
+  build.parameters.entry.modal.modes = 4;
+  ASSERT_TRUE(io::buildDatabase(path, build).ok());
+  const std::vector<io::NamedMesh> shapes{{"brick", "", core::makeBox({0.2, 0.1, 0.05})},
+                                          {"bar", "", core::makeBox({0.3, 0.04, 0.03})}};
+  EvaluationOptions options;
+  options.frequencies = 4;
+
+  auto cold = io::Database::open(path);
+  ASSERT_TRUE(cold.ok());
+  auto withoutWarmUp = evaluateShapes(*cold, shapes, options);
+  ASSERT_TRUE(withoutWarmUp.ok()) << withoutWarmUp.error().message;
+
+  auto timed = io::Database::open(path);
+  auto other = io::Database::open(path);
+  ASSERT_TRUE(timed.ok() && other.ok());
+  options.warmUp = &*other;
+  auto withWarmUp = evaluateShapes(*timed, shapes, options);
+  ASSERT_TRUE(withWarmUp.ok()) << withWarmUp.error().message;
+
+  // The warm-up queried its own instance; the timed one fetched every entry itself, as without it.
+  EXPECT_GT(other->cacheStats()[1], 0u);
+  EXPECT_EQ(timed->cacheStats(), cold->cacheStats());
+  // And every method answered as without it, to the bit.
+  ASSERT_EQ(withWarmUp->size(), shapes.size());
+  for (std::size_t i = 0; i < shapes.size(); ++i) {
+    const FragmentEvaluation &a = (*withoutWarmUp)[i], &b = (*withWarmUp)[i];
+    ASSERT_TRUE(a.ok() && b.ok()) << a.error << b.error;
+    ASSERT_EQ(a.methods.size(), b.methods.size());
+    for (std::size_t m = 0; m < a.methods.size(); ++m) {
+      ASSERT_EQ(a.methods[m].frequenciesHz.size(), b.methods[m].frequenciesHz.size());
+      for (Eigen::Index f = 0; f < a.methods[m].frequenciesHz.size(); ++f)
+        EXPECT_EQ(a.methods[m].frequenciesHz[f], b.methods[m].frequenciesHz[f])
+            << shapes[i].name << " " << toString(a.methods[m].method) << " frequency " << f;
+      EXPECT_EQ(a.methods[m].match, b.methods[m].match);
+    }
+  }
+
+  // The timed instance itself, or an instance of another file, is refused before any work.
+  options.warmUp = &*timed;
+  EXPECT_EQ(evaluateShapes(*timed, shapes, options).error().code, ErrorCode::kInvalidArgument);
+  build.parameters.entries = 3;
+  ASSERT_TRUE(io::buildDatabase(dir / "smaller.db", build).ok());
+  auto smaller = io::Database::open(dir / "smaller.db");
+  ASSERT_TRUE(smaller.ok());
+  options.warmUp = &*smaller;
+  auto refused = evaluateShapes(*timed, shapes, options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("same file"), std::string::npos) << refused.error().message;
+}
+
 }  // namespace
 }  // namespace shapedb::bench

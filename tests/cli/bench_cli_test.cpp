@@ -51,6 +51,7 @@ TEST(BenchCli, FractureFragmentsEvaluatedWithSaneCsvSummaryAndPlots) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("| centroid-voxel |"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("direct computations done"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a warm-up round, then"), std::string::npos) << r.err;  // on by default
 
   std::ifstream csv(out / "evaluation.csv");
   ASSERT_TRUE(csv.good());
