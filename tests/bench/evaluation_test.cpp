@@ -159,14 +159,19 @@ TEST(Evaluation, KnownAnswersForEntriesBoxesAndEllipsoids) {
   EXPECT_EQ(evaluateShapes(*db, shapes, options).error().code, ErrorCode::kInvalidArgument);
 }
 
+/// A small database's build: `entries` boxes of four modes.
+io::BuildOptions boxes(std::size_t entries) {
+  io::BuildOptions build;
+  build.parameters.entries = entries;
+  build.parameters.families = {volume::Family::kBox};
+  build.parameters.entry.modal.modes = 4;
+  return build;
+}
+
 TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
   test::ScratchDir dir("evaluation-bad");
   const auto path = dir / "small.db";
-  io::BuildOptions build;
-  build.parameters.entries = 4;
-  build.parameters.families = {volume::Family::kBox};
-  build.parameters.entry.modal.modes = 4;
-  auto report = io::buildDatabase(path, build);
+  auto report = io::buildDatabase(path, boxes(4));
   ASSERT_TRUE(report.ok()) << report.error().message;
   auto db = io::Database::open(path);
   ASSERT_TRUE(db.ok());
@@ -205,11 +210,7 @@ TEST(Evaluation, AShapeThatCannotBeQueriedIsReportedAndTheOthersGoOn) {
 TEST(Evaluation, TheWarmUpRunsOnAnInstanceOfItsOwnAndChangesNoAnswer) {
   test::ScratchDir dir("evaluation-warm-up");
   const auto path = dir / "small.db";
-  io::BuildOptions build;
-  build.parameters.entries = 4;
-  build.parameters.families = {volume::Family::kBox};
-  build.parameters.entry.modal.modes = 4;
-  ASSERT_TRUE(io::buildDatabase(path, build).ok());
+  ASSERT_TRUE(io::buildDatabase(path, boxes(4)).ok());
   const std::vector<io::NamedMesh> shapes{{"brick", "", core::makeBox({0.2, 0.1, 0.05})},
                                           {"bar", "", core::makeBox({0.3, 0.04, 0.03})}};
   EvaluationOptions options;
@@ -248,8 +249,7 @@ TEST(Evaluation, TheWarmUpRunsOnAnInstanceOfItsOwnAndChangesNoAnswer) {
   // The timed instance itself, or an instance of another file, is refused before any work.
   options.warmUp = &*timed;
   EXPECT_EQ(evaluateShapes(*timed, shapes, options).error().code, ErrorCode::kInvalidArgument);
-  build.parameters.entries = 3;
-  ASSERT_TRUE(io::buildDatabase(dir / "smaller.db", build).ok());
+  ASSERT_TRUE(io::buildDatabase(dir / "smaller.db", boxes(3)).ok());
   auto smaller = io::Database::open(dir / "smaller.db");
   ASSERT_TRUE(smaller.ok());
   options.warmUp = &*smaller;
