@@ -151,6 +151,13 @@ TEST(BenchCli, UsageAndInputErrorsAreClear) {
       SHAPEDB_CLI, {"bench", db.string(), "--queries", queries.string(), "--out", (dir / "o").string()});
   EXPECT_EQ(tooMany.exitCode, 2);  // 5 frequencies by default; the database has 2 modes
   EXPECT_NE(tooMany.err.find("2 modes"), std::string::npos) << tooMany.err;
+  // Without the warm-up round the summary says the queries were timed in a cold process.
+  test::ProcessResult cold = test::runProcess(
+      SHAPEDB_CLI, {"bench", db.string(), "--queries", queries.string(), "--frequencies", "2", "--no-warm-up",
+                    "--truth-refinement", "2", "--out", (dir / "cold").string()});
+  EXPECT_EQ(cold.exitCode, 0) << cold.err;
+  EXPECT_EQ(cold.err.find("warm-up round"), std::string::npos) << cold.err;
+  EXPECT_NE(cold.out.find("queries timed in a cold process (--no-warm-up)"), std::string::npos) << cold.out;
   test::ProcessResult help = test::runProcess(SHAPEDB_CLI, {"bench", "--help"});
   EXPECT_EQ(help.exitCode, 0);
   EXPECT_NE(help.out.find("physical-fidelity benchmark"), std::string::npos);
