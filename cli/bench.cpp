@@ -98,7 +98,7 @@ int runBench(BenchCommandOptions& o, const CLI::App& app) {
   }
 
   const auto start = std::chrono::steady_clock::now();
-  std::fprintf(stderr, "bench: %zu shapes: %s6 queries each, then the direct computations...\n",
+  std::fprintf(stderr, "bench: %zu shapes: %seach shape's queries, then the direct computations...\n",
                shapes->size(), o.noWarmUp ? "" : "a warm-up round, then ");
   o.evaluation.progress = [start](std::size_t done, std::size_t total, const std::string& name) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -137,7 +137,7 @@ struct EvaluationOptions {
   /// size and kept, its threads and libraries started), as the direct computations after them are, while
   /// the timed instance has still fetched no entry and planned no correction. Without it the first shapes
   /// of a run pay for the process's start: on the development machine the first shape's corrected query
-  /// took 10-15 ms more than the same query last in the run.
+  /// took 43 ms, the same query last in the run 29 ms.
   const io::Database* warmUp = nullptr;
   /// Called after each shape's direct computation, from one thread at a time: done, total, its name.
   std::function<void(std::size_t, std::size_t, const std::string&)> progress;
